@@ -1,0 +1,141 @@
+"""``thruster-hil``: the bench operator's console.
+
+Subcommands: ``run SCENARIO`` (bench + flight software as two processes, lockstep or
+realtime), ``bench SCENARIO`` (the bench alone, for external flight software or hardware
+on the same bus), ``report RUN_DIR`` (redraw plots, print the summary). Exit codes:
+0 pass, 1 the run's expectations failed, 2 bad input (scenario, options), 3 run error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from dbc.bus import BusSpec, default_bus_spec
+from dbc.errors import BusError, ConfigError, RunError
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
+BAR_WIDTH = 30
+
+
+def _progress_printer() -> Any:
+    tty = sys.stderr.isatty()
+    last = [-1.0]
+
+    def show(t_s: float, total_s: float) -> None:
+        frac = min(1.0, t_s / total_s) if total_s > 0 else 1.0
+        if tty:
+            n = int(frac * BAR_WIDTH)
+            sys.stderr.write(f"\r[{'#' * n}{'.' * (BAR_WIDTH - n)}] {t_s:7.2f}/{total_s:.2f} s sim")
+            sys.stderr.flush()
+        elif frac - last[0] >= 0.1 or frac >= 1.0:
+            last[0] = frac
+            sys.stderr.write(f"progress {frac * 100:5.1f} % ({t_s:.1f}/{total_s:.1f} s sim)\n")
+    return show
+
+
+def _print_summary(s: dict[str, Any], out: Path) -> None:
+    lat = s["latency_us"]["sensor_to_command"]
+    lines = [
+        f"scenario {s['scenario']} | mode {s['mode']} | bus {s['bus']} | seed {s['seed']}",
+        f"sim {s['sim_time_s']:.1f} s in {s['wall_time_s']:.2f} s wall "
+        f"(real-time factor {s['realtime_factor']})",
+        f"converged {s['converged']} | settling {s['settling_time_s']} s | "
+        f"steady-state error {s['steady_state_attitude_error_deg']:.4f} deg, "
+        f"{s['steady_state_rate_error_deg_s']:.4f} deg/s",
+        f"propellant {s['propellant_kg'] * 1000:.1f} g | valve openings {s['valve_openings']['total']}",
+        f"latency sensor->command p50 {lat['p50']} us, p99 {lat['p99']} us, max {lat['max']} us "
+        f"(n={lat['n']}) | deadline misses {s['deadline_misses']}",
+    ]
+    for e in s["expectations"]:
+        lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {e['value']} (max {e['max']})")
+    if "error" in s:
+        lines.append(f"  ERROR {s['error']}")
+    lines.append(f"run folder: {out}")
+    print("\n".join(lines))
+
+
+def _default_out(name: str) -> Path:
+    return Path("runs") / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
+    from bench.orchestrator import DEFAULT_FSW_CMD, RunOptions, run_scenario
+    from bench.scenario import load_scenario
+
+    sc = load_scenario(args.scenario)
+    bus = args.bus or default_bus_spec()
+    BusSpec.parse(bus)
+    opts = RunOptions(
+        mode=args.mode, bus=bus, seed=sc.seed if args.seed is None else args.seed,
+        out=Path(args.out) if args.out else _default_out(sc.name),
+        duration_s=args.duration if args.duration is not None else sc.duration_s,
+        fsw_cmd=None if alone else (args.fsw_cmd or DEFAULT_FSW_CMD),
+    )
+    if alone:
+        print(f"bench waiting for flight software on {bus} (FSW_STATUS heartbeat), "
+              f"mode {opts.mode}, up to {sc.bus.startup_timeout_s} s", file=sys.stderr)
+    summary = run_scenario(sc, opts, _progress_printer())
+    if sys.stderr.isatty():
+        sys.stderr.write("\n")
+    _print_summary(summary, opts.out)
+    return EXIT_OK if summary["passed"] else EXIT_FAILED
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from bench.plots import plot_run
+
+    run_dir = Path(args.run_dir)
+    path = run_dir / "summary.json"
+    if not path.exists():
+        raise RunError(f"{path}: no summary.json (not a run folder?)")
+    s = json.loads(path.read_text(encoding="utf-8"))
+    for p in plot_run(run_dir, s.get("settling_band_deg")):
+        print(f"wrote {p}")
+    _print_summary(s, run_dir)
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``thruster-hil``."""
+    p = argparse.ArgumentParser(prog="thruster-hil", description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    for name, help_ in (("run", "run a scenario: bench + flight software"),
+                        ("bench", "run the bench alone; pair it with external flight software")):
+        r = sub.add_parser(name, help=help_)
+        r.add_argument("scenario", help="scenario TOML file")
+        r.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
+        r.add_argument("--bus", help="bus spec INTERFACE:CHANNEL (default: socketcan:vcan0 if "
+                                     "present, else hilbus:default)")
+        r.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
+        r.add_argument("--out", help="run folder (default: runs/<scenario>-<time>)")
+        r.add_argument("--duration", type=float, help="override the scenario duration [s]")
+        if name == "run":
+            r.add_argument("--fsw-cmd", help="flight-software command; placeholders {bus} {mode} "
+                                             "{config} {stats} {run_dir}")
+    rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
+    rp.add_argument("run_dir")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``thruster-hil`` console script."""
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "report":
+            return _cmd_report(args)
+        return _cmd_run(args, alone=args.command == "bench")
+    except (ConfigError, BusError) as exc:
+        print(f"thruster-hil: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RunError as exc:
+        print(f"thruster-hil: run error: {exc}", file=sys.stderr)
+        return EXIT_RUN_ERROR
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,70 @@
+"""Run metrics from truth telemetry: convergence, settling, steady-state errors, latency percentiles.
+
+Pure functions over arrays. Inputs: sample times [s], attitude error angle [deg] between
+true attitude and the manoeuvre's target, rate error [deg/s]. Settling time is the first
+time after which the error stays inside the band until the end; converged means settled
+and the final error inside the band. Steady-state errors are maxima over the last window.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+PERCENTILES = (50.0, 99.0)
+
+
+@dataclass(frozen=True)
+class PointingMetrics:
+    """Convergence figures of one run."""
+
+    converged: bool
+    settling_time_s: float | None
+    steady_state_attitude_error_deg: float
+    steady_state_rate_error_deg_s: float
+    final_attitude_error_deg: float
+
+
+def pointing_metrics(
+    t_s: np.ndarray, att_err_deg: np.ndarray, rate_err_deg_s: np.ndarray,
+    band_deg: float, window_s: float, t_start_s: float = 0.0,
+) -> PointingMetrics:
+    """Settling time (from ``t_start_s``), convergence and steady-state errors."""
+    if len(t_s) == 0:
+        return PointingMetrics(False, None, float("nan"), float("nan"), float("nan"))
+    outside = np.nonzero(att_err_deg > band_deg)[0]
+    final = float(att_err_deg[-1])
+    if len(outside) == 0:
+        settling: float | None = 0.0
+    elif outside[-1] == len(t_s) - 1:
+        settling = None
+    else:
+        settling = float(t_s[outside[-1] + 1] - t_start_s)
+    last = t_s >= t_s[-1] - window_s
+    return PointingMetrics(
+        converged=settling is not None and final <= band_deg,
+        settling_time_s=settling,
+        steady_state_attitude_error_deg=float(np.max(att_err_deg[last])),
+        steady_state_rate_error_deg_s=float(np.max(rate_err_deg_s[last])),
+        final_attitude_error_deg=final,
+    )
+
+
+def latency_summary(samples_ns: list[int]) -> dict[str, Any]:
+    """p50, p99, max in microseconds and the sample count."""
+    if not samples_ns:
+        return {"p50": None, "p99": None, "max": None, "n": 0}
+    a = np.asarray(samples_ns, dtype=float) / 1e3
+    p50, p99 = np.percentile(a, PERCENTILES)
+    return {"p50": round(float(p50), 3), "p99": round(float(p99), 3),
+            "max": round(float(a.max()), 3), "n": len(samples_ns)}
+
+
+def expectation(name: str, value: float | None, limit: float | None) -> dict[str, Any] | None:
+    """One expectation row: value, limit, pass (value <= limit); None if no limit set."""
+    if limit is None:
+        return None
+    ok = value is not None and bool(np.isfinite(value)) and value <= limit
+    return {"name": name, "value": value, "max": limit, "pass": ok}

@@ -1,0 +1,496 @@
+"""The bench process: plant, valve drivers, sensors, time master, recorder, metrics.
+
+Frames out: SYNC (lockstep), IMU_RATE, IMU_ACCEL, STR_QUAT, THR_STATUS, BENCH_STATUS.
+Frames in (checked on receipt: ID, DLC, CRC, alive counter, range; freshness by cycle
+number): THR_CMD_0..3, FSW_STATUS, FSW_ATT_EST. Rates come from the DBC cycle times.
+
+Lockstep (DESIGN §5): per control cycle k the bench sends every sensor sample due in
+(t_{k-1}, t_k], then SYNC(k); it waits for the flight software's THR_CMD frames of cycle k,
+delivers them to the valves at the time the bus model says they arrive (flight-software
+response delay from the scenario, then arbitration and exact frame length), and
+integrates to t_{k+1}. A missing answer within ``stall_timeout_s`` of wall time is a counted
+stall; after ``SILENT_AFTER_STALLS`` stalls in a row the flight software is declared silent
+and the bench stops waiting (never hangs). Realtime: the bench paces the plant to its own
+monotonic clock, sends sensors when due and applies commands when they arrive; all
+latencies are measured. Valve watchdog: no valid command for ``WATCHDOG_PERIODS`` command
+periods closes every valve and records the event.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import can
+import numpy as np
+from cantools.database.can import Database
+
+from bench.bus.timing import BusArbiter, frame_bits
+from bench.metrics import expectation, latency_summary, pointing_metrics
+from bench.plant import STEP_NS, Plant
+from bench.recorder import TelemetryWriter, TraceRecorder
+from bench.scenario import Scenario
+from dbc.codec import Encoder, FrameChecker, Reject, cycle_time_ns
+from dbc.errors import RunError
+from dbc.quaternion import pack_quaternion, unpack_quaternion
+
+WATCHDOG_PERIODS = 3
+STARTUP_POLL_S = 0.2
+SILENT_AFTER_STALLS = 3
+THRUSTERS_PER_CMD_FRAME = 4
+CYCLE_MODULUS = 256
+NS_PER_S = 1_000_000_000
+RAD_DEG = 180.0 / math.pi
+TELEMETRY_PERIOD_NS = 10_000_000
+SENSOR_ORDER = ("IMU_RATE", "IMU_ACCEL", "STR_QUAT", "THR_STATUS", "BENCH_STATUS")
+FSW_FRAMES = frozenset({"THR_CMD_0", "THR_CMD_1", "THR_CMD_2", "THR_CMD_3", "FSW_STATUS",
+                        "FSW_ATT_EST", "FAULT_CMD"})
+HEALTH_WATCHDOG = 0x1
+HEALTH_FSW_SILENT = 0x2
+
+
+def quat_error_deg(q: tuple[float, ...] | np.ndarray, r: tuple[float, ...]) -> float:
+    """Rotation angle between attitudes q and r [deg]."""
+    d = abs(q[0] * r[0] + q[1] * r[1] + q[2] * r[2] + q[3] * r[3])
+    return 2.0 * math.acos(min(1.0, d)) * RAD_DEG
+
+
+def frame_table(db: Database, me: str, sent: dict[str, int],
+                received: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """Per message: its sender, and what node ``me`` knows (what it sent, or what it received).
+
+    The other side's counts are merged in by :func:`merge_peer_counts`.
+    """
+    table: dict[str, dict[str, Any]] = {}
+    for m in db.messages:
+        sender = m.senders[0] if m.senders else "?"
+        table[m.name] = {"sender": sender, "sent": None, "received": None, "gaps": None,
+                         "rejected": {}}
+    for name, n in sent.items():
+        table[name]["sent"] = n
+    for name, r in received.items():
+        row = table.setdefault(name, {"sender": "?", "sent": None})
+        row.update(received=r["received"], gaps=r["gaps"], rejected=r["rejected"])
+    return table
+
+
+def merge_peer_counts(table: dict[str, dict[str, Any]], sent: dict[str, int],
+                      received: dict[str, dict[str, Any]]) -> None:
+    """Fill in the peer's side: what it sent and what it received, by message."""
+    for name, n in sent.items():
+        if name in table:
+            table[name]["sent"] = n
+    for name, r in received.items():
+        row = table.setdefault(name, {"sender": "?", "sent": None})
+        row.update(received=r["received"], gaps=r["gaps"], rejected=r["rejected"])
+
+
+@dataclass
+class Clock:
+    """The bench's wall clock (the only reader of wall time in the bench)."""
+
+    t0_ns: int = field(default_factory=time.monotonic_ns)
+
+    def now_ns(self) -> int:
+        """Nanoseconds since the clock was made."""
+        return time.monotonic_ns() - self.t0_ns
+
+
+class BenchNode:
+    """One bench run on one bus."""
+
+    def __init__(self, sc: Scenario, db: Database, bus: can.BusABC, run_dir: Path,
+                 mode: str, seed: int, bus_spec: str,
+                 progress: Callable[[float, float], None] | None = None) -> None:
+        self.sc, self.db, self.bus, self.run_dir = sc, db, bus, run_dir
+        self.mode, self.seed, self.bus_spec = mode, seed, bus_spec
+        self.progress = progress
+        self.encoder = Encoder(db)
+        self.checker = FrameChecker(db, accept=FSW_FRAMES)
+        self.period_ns = cycle_time_ns(db, "THR_CMD_0")
+        self.sensor_period_ns = {n: cycle_time_ns(db, n) for n in SENSOR_ORDER}
+        self.plant = Plant(sc, seed, self.sensor_period_ns["IMU_RATE"])
+        self.n_thr = len(sc.thrusters)
+        self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
+        self.arbiter = BusArbiter(sc.bus.bitrate_bps)
+        self.trace = TraceRecorder(run_dir)
+        self.telemetry = TelemetryWriter(run_dir / "telemetry.csv", self._columns())
+        self.pulses = TelemetryWriter(run_dir / "valve_pulses.csv",
+                                      ["t_on_s", "t_off_s", "thruster"])
+        self.sent: dict[str, int] = {}
+        self.queue: list[tuple[int, int, str, dict[str, float | int]]] = []
+        self.imu_tx_ns: dict[int, int] = {}
+        self.latency_ns: list[int] = []
+        self.last_cmd_ns = 0
+        self.watchdog_tripped = False
+        self.watchdog_trips = 0
+        self.stalls = 0
+        self.consecutive_stalls = 0
+        self.fsw_silent = False
+        self.late_steps = 0
+        self.fsw_status: dict[str, float] = {}
+        self.fsw_q_est: tuple[float, float, float, float] | None = None
+        self.fsw_q_valid = False
+        self.fsw_est_err_deg = float("nan")
+        self.faults_log: list[dict[str, Any]] = []
+        self.pending_faults = list(sc.faults)
+        self.active_faults: dict[int, str] = {}
+        self.fault_clears: list[tuple[int, int]] = []
+        self.on_time_last = [0.0] * self.n_thr
+        self.tel_t: list[float] = []
+        self.tel_err: list[float] = []
+        self.tel_rate_err: list[float] = []
+        self.wall_s = 0.0
+        self.fsw_alive: Callable[[], bool] | None = None
+        self._wire_pending: dict[int, tuple[can.Message, bool]] = {}
+
+    # -- telemetry ---------------------------------------------------------------
+    def _columns(self) -> list[str]:
+        cols = ["t_s", "q0", "q1", "q2", "q3", "wx_rad_s", "wy_rad_s", "wz_rad_s",
+                "rx_m", "ry_m", "rz_m", "vx_m_s", "vy_m_s", "vz_m_s",
+                "att_err_deg", "rate_err_deg_s",
+                "fsw_q0", "fsw_q1", "fsw_q2", "fsw_q3", "fsw_est_err_deg", "fsw_mode"]
+        cols += [f"thrust_T{k:02d}_N" for k in range(len(self.sc.thrusters))]
+        return cols + ["propellant_kg"]
+
+    def _telemetry_row(self, t_ns: int) -> None:
+        s = self.plant.state
+        q = s[0:4]
+        err = quat_error_deg(q, self.sc.q_target_BN)
+        rate_err = math.sqrt(s[4] ** 2 + s[5] ** 2 + s[6] ** 2) * RAD_DEG
+        fq = self.fsw_q_est if (self.fsw_q_est and self.fsw_q_valid) else None
+        est_err = self.fsw_est_err_deg if fq else float("nan")
+        thr = self.plant.thrusters
+        row: list[float | int | str] = [t_ns / NS_PER_S, *q, *s[4:13], err, rate_err]
+        row += list(fq) if fq else [float("nan")] * 4
+        row += [est_err, int(self.fsw_status.get("Mode", -1))]
+        row += [thr.valves[k].thrust_N(t_ns) for k in range(self.n_thr)]
+        row.append(thr.total_propellant_kg)
+        self.telemetry.row(row)
+        if t_ns >= self.sc.manoeuvre_start_s * NS_PER_S:
+            self.tel_t.append(t_ns / NS_PER_S)
+            self.tel_err.append(err)
+            self.tel_rate_err.append(rate_err)
+
+    # -- sensors -----------------------------------------------------------------
+    def _sample(self, name: str, t_ns: int) -> dict[str, float | int]:
+        p = self.plant
+        s = p.state
+        if name == "IMU_RATE":
+            w = p.gyro.sample(t_ns, (s[4], s[5], s[6]))
+            return {"Valid": 1, "RateX": w[0], "RateY": w[1], "RateZ": w[2]}
+        if name == "IMU_ACCEL":
+            a = p.accel.sample(t_ns, p.specific_force_B())
+            return {"Valid": 1, "AccelX": a[0], "AccelY": a[1], "AccelZ": a[2]}
+        if name == "STR_QUAT":
+            q, valid = p.star.sample(t_ns, (s[0], s[1], s[2], s[3]))
+            return {"Valid": int(valid), **pack_quaternion(q)}
+        if name == "THR_STATUS":
+            sig: dict[str, float | int] = {}
+            for k, (cmd, opn, cur) in enumerate(p.thrusters.status(t_ns)):
+                sig[f"Cmd_T{k:02d}"], sig[f"Open_T{k:02d}"], sig[f"Current_T{k:02d}"] = (
+                    int(cmd), int(opn), int(cur))
+            for k in range(self.n_thr, 16):
+                sig[f"Cmd_T{k:02d}"] = sig[f"Open_T{k:02d}"] = sig[f"Current_T{k:02d}"] = 0
+            return sig
+        # BENCH_STATUS
+        health = (HEALTH_WATCHDOG if self.watchdog_tripped else 0) | (
+            HEALTH_FSW_SILENT if self.fsw_silent else 0)
+        return {"SimTime": t_ns / NS_PER_S, "ActiveFaults": len(self.active_faults), "Health": health}
+
+    def _queue_due(self, t_ns: int) -> None:
+        for name in SENSOR_ORDER:
+            if t_ns % self.sensor_period_ns[name] == 0:
+                self.queue.append((t_ns, self.encoder.frame_id(name), name, self._sample(name, t_ns)))
+
+    # -- faults and watchdog -----------------------------------------------------
+    def _faults_due(self, t_ns: int) -> None:
+        while self.pending_faults and self.pending_faults[0].t_s * NS_PER_S <= t_ns:
+            f = self.pending_faults.pop(0)
+            self.plant.thrusters.set_fault(f.thruster, f.kind)
+            self.active_faults[f.thruster] = f.kind
+            rec = {"t_s": t_ns / NS_PER_S, "kind": f.kind, "thruster": f.thruster,
+                   "duration_s": f.duration_s, "source": "scenario"}
+            self.faults_log.append(rec)
+            self.trace.event(t_ns, "fault_injected", **rec)
+            if f.duration_s > 0:
+                self.fault_clears.append((t_ns + round(f.duration_s * NS_PER_S), f.thruster))
+        for clear in [c for c in self.fault_clears if c[0] <= t_ns]:
+            self.fault_clears.remove(clear)
+            self.plant.thrusters.set_fault(clear[1], None)
+            self.active_faults.pop(clear[1], None)
+            self.trace.event(t_ns, "fault_cleared", thruster=clear[1])
+
+    def _watchdog(self, t_ns: int) -> None:
+        if not self.watchdog_tripped and t_ns - self.last_cmd_ns > WATCHDOG_PERIODS * self.period_ns:
+            self.plant.thrusters.close_all(t_ns)
+            self.watchdog_tripped = True
+            self.watchdog_trips += 1
+            self.trace.event(t_ns, "valve_watchdog", action="all valves closed",
+                             last_command_s=self.last_cmd_ns / NS_PER_S)
+
+    # -- integration -------------------------------------------------------------
+    def integrate_to(self, t_end_ns: int) -> None:
+        """Advance the plant, sampling sensors and telemetry on the way."""
+        while self.plant.t_ns < t_end_ns:
+            t = self.plant.t_ns + STEP_NS
+            self.plant.advance_to(t)
+            self._faults_due(t)
+            self._watchdog(t)
+            if t % TELEMETRY_PERIOD_NS == 0:
+                self._telemetry_row(t)
+            self._queue_due(t)
+
+    # -- transmit / receive --------------------------------------------------------
+    def _send(self, name: str, signals: dict[str, float | int], ready_ns: int,
+              realtime_ns: int | None = None) -> can.Message:
+        msg = self.encoder.message(name, signals)
+        self.bus.send(msg)
+        self.sent[name] = self.sent.get(name, 0) + 1
+        if realtime_ns is not None:
+            self.trace.frame(msg, realtime_ns, tx=True)
+        else:
+            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data)))
+            self._wire_pending[seq] = (msg, True)
+        if name == "IMU_RATE":
+            self.imu_tx_ns[msg.data[1] & 0x0F] = ready_ns if realtime_ns is None else realtime_ns
+        return msg
+
+    def _flush_wire(self, until_ns: int | None = None) -> dict[int, int]:
+        """Resolve bus arbitration; record frames in wire order. Returns seq -> rx time."""
+        rx: dict[int, int] = {}
+        for d in self.arbiter.resolve(until_ns):
+            msg, tx = self._wire_pending.pop(d.seq)
+            self.trace.frame(msg, d.end_ns, tx=tx)
+            rx[d.seq] = d.end_ns
+        return rx
+
+    def _send_queue(self, realtime_ns: int | None = None) -> None:
+        self.queue.sort(key=lambda f: (f[0], f[1]))
+        for t_ns, _id, name, sig in self.queue:
+            self._send(name, sig, t_ns, realtime_ns)
+        self.queue.clear()
+
+    def _on_fsw_frame(self, d_name: str, s: dict[str, float]) -> None:
+        if d_name == "FSW_STATUS":
+            self.fsw_status = s
+        elif d_name == "FSW_ATT_EST":
+            self.fsw_q_est = unpack_quaternion(s)
+            # the estimate is of the cycle's time t_k, which is where the plant is now (lockstep)
+            self.fsw_est_err_deg = quat_error_deg(self.plant.state[0:4], self.fsw_q_est)
+            self.fsw_q_valid = bool(s["Valid"])
+
+    def _apply_command(self, s: dict[str, float], frame_index: int, t_rx_ns: int) -> None:
+        for j in range(THRUSTERS_PER_CMD_FRAME):
+            k = frame_index * THRUSTERS_PER_CMD_FRAME + j
+            if k >= self.n_thr:
+                break
+            on_s = float(s[f"OnTime_T{k:02d}"])
+            on_ns = round(on_s * NS_PER_S)
+            self.plant.thrusters.command(t_rx_ns, k, on_ns)
+            self.on_time_last[k] = on_s
+            if on_ns > 0:
+                self.pulses.row([t_rx_ns / NS_PER_S, (t_rx_ns + on_ns) / NS_PER_S, k])
+
+    # -- lockstep ----------------------------------------------------------------
+    def wait_for_fsw(self) -> None:
+        """Wait for the flight software's first valid frame (its boot heartbeat)."""
+        deadline = time.monotonic() + self.sc.bus.startup_timeout_s
+        while time.monotonic() < deadline:
+            if self.fsw_alive is not None and not self.fsw_alive():
+                raise RunError("the flight-software process exited before its first frame "
+                               "(see fsw.log in the run folder)")
+            msg = self.bus.recv(timeout=min(STARTUP_POLL_S, max(0.0, deadline - time.monotonic())))
+            if msg is None:
+                continue
+            d = self.checker.check(msg)
+            if d is not None:
+                self.trace.frame(msg, 0, tx=False)
+                self._on_fsw_frame(d.name, d.signals)  # type: ignore[arg-type]
+                return
+        raise RunError(
+            f"no flight software on bus {self.bus_spec} within "
+            f"{self.sc.bus.startup_timeout_s} s (expected its FSW_STATUS heartbeat)")
+
+    def run_lockstep(self, duration_s: float) -> None:
+        """Lockstep run of ``duration_s`` simulated seconds."""
+        n_cycles = round(duration_s * NS_PER_S / self.period_ns)
+        delay_ns = round(self.sc.bus.fsw_response_delay_s * NS_PER_S)
+        self.wait_for_fsw()
+        wall0 = time.monotonic()
+        self._queue_due(0)
+        self._telemetry_row(0)
+        for k in range(n_cycles):
+            t_k = k * self.period_ns
+            self._send_queue()
+            self._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S}, t_k)
+            self._collect_lockstep(k, t_k + delay_ns)
+            self.integrate_to(t_k + self.period_ns)
+            if k % 5 == 0:
+                self.trace.flush()
+                self.telemetry.flush()
+                self.pulses.flush()
+                if self.progress is not None:
+                    self.progress(t_k / NS_PER_S, duration_s)
+        self._flush_wire()
+        self.queue.clear()
+        self.wall_s = time.monotonic() - wall0
+
+    def _collect_lockstep(self, k: int, ready_ns: int) -> None:
+        """Receive this cycle's commands, deliver them at their modelled arrival."""
+        want = self.n_cmd_frames
+        got: list[tuple[int, int, dict[str, float]]] = []  # (frame index, seq, signals)
+        fsw_dead = self.fsw_alive is not None and not self.fsw_alive()
+        timeout = 0.0 if (self.fsw_silent or fsw_dead) else self.sc.bus.stall_timeout_s
+        deadline = time.monotonic() + timeout
+        imu_counter = None
+        while len(got) < want:
+            remaining = deadline - time.monotonic()
+            msg = self.bus.recv(timeout=max(0.0, remaining))
+            if msg is None:
+                break
+            d = self.checker.check(msg)
+            if d is None:
+                continue
+            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data)))
+            self._wire_pending[seq] = (msg, False)
+            s: dict[str, float] = d.signals  # type: ignore[assignment]
+            if d.name.startswith("THR_CMD_"):
+                if int(s["Cycle"]) != k % CYCLE_MODULUS:
+                    self.checker.reject(d.name, Reject.STALE)
+                    continue
+                got.append((int(d.name[-1]), seq, s))
+                imu_counter = int(s["ImuCounter"])
+            else:
+                self._on_fsw_frame(d.name, s)
+        rx = self._flush_wire(ready_ns + self.period_ns)
+        if len(got) < want:
+            self.stalls += 1
+            self.consecutive_stalls += 1
+            if not self.fsw_silent:
+                self.trace.event(k * self.period_ns, "stall", cycle=k, frames=len(got))
+            if self.consecutive_stalls >= SILENT_AFTER_STALLS and not self.fsw_silent:
+                self.fsw_silent = True
+                self.trace.event(k * self.period_ns, "fsw_silent", cycle=k)
+        else:
+            if self.fsw_silent:
+                self.trace.event(k * self.period_ns, "fsw_back", cycle=k)
+            self.consecutive_stalls = 0
+            self.fsw_silent = False
+        if not got:
+            return
+        t_last = 0
+        for index, seq, s in sorted(got):
+            t_rx = rx[seq]
+            t_last = max(t_last, t_rx)
+            self._apply_command(s, index, t_rx)
+        self.last_cmd_ns = t_last
+        if self.watchdog_tripped:
+            self.trace.event(t_last, "valve_watchdog_cleared")
+            self.watchdog_tripped = False
+        if imu_counter is not None and imu_counter in self.imu_tx_ns:
+            self.latency_ns.append(t_last - self.imu_tx_ns[imu_counter])
+
+    # -- realtime ----------------------------------------------------------------
+    def run_realtime(self, duration_s: float, clock: Clock | None = None) -> None:
+        """Wall-clock-paced run of ``duration_s`` seconds."""
+        self.wait_for_fsw()
+        clock = clock or Clock()
+        end_ns = round(duration_s * NS_PER_S)
+        self._queue_due(0)
+        self._telemetry_row(0)
+        self._send_queue(realtime_ns=clock.now_ns())
+        next_progress = 0
+        while self.plant.t_ns < end_ns:
+            now = clock.now_ns()
+            if now - self.plant.t_ns > self.period_ns:
+                self.late_steps += 1
+            while self.plant.t_ns + STEP_NS <= min(now, end_ns):
+                self.integrate_to(self.plant.t_ns + STEP_NS)
+                if self.queue:
+                    self._send_queue(realtime_ns=clock.now_ns())
+            wait_s = max(0.0, (self.plant.t_ns + STEP_NS - clock.now_ns()) / NS_PER_S)
+            msg = self.bus.recv(timeout=wait_s)
+            while msg is not None:
+                self._on_realtime_frame(msg, clock.now_ns())
+                msg = self.bus.recv(timeout=0.0)
+            if self.plant.t_ns >= next_progress:
+                self.trace.flush()
+                self.telemetry.flush()
+                self.pulses.flush()
+                if self.progress is not None:
+                    self.progress(self.plant.t_ns / NS_PER_S, duration_s)
+                next_progress += 5 * self.period_ns
+        self.wall_s = clock.now_ns() / NS_PER_S
+
+    def _on_realtime_frame(self, msg: can.Message, t_ns: int) -> None:
+        d = self.checker.check(msg)
+        if d is None:
+            return
+        self.trace.frame(msg, t_ns, tx=False)
+        s: dict[str, float] = d.signals  # type: ignore[assignment]
+        if d.name.startswith("THR_CMD_"):
+            t_apply = max(t_ns, self.plant.t_ns)
+            self._apply_command(s, int(d.name[-1]), t_apply)
+            self.last_cmd_ns = t_apply
+            self.watchdog_tripped = False
+            self.fsw_silent = False
+            c = int(s["ImuCounter"])
+            if d.name == f"THR_CMD_{self.n_cmd_frames - 1}" and c in self.imu_tx_ns:
+                self.latency_ns.append(t_ns - self.imu_tx_ns[c])
+        else:
+            self._on_fsw_frame(d.name, s)
+
+    # -- results -----------------------------------------------------------------
+    def summary(self, sim_time_s: float) -> dict[str, Any]:
+        """summary.json content from the bench's side."""
+        sc = self.sc
+        pm = pointing_metrics(np.asarray(self.tel_t), np.asarray(self.tel_err),
+                              np.asarray(self.tel_rate_err), sc.expectations.settling_band_deg,
+                              sc.expectations.steady_state_window_s, sc.manoeuvre_start_s)
+        frames = frame_table(self.db, "BENCH", self.sent, self.checker.summary())
+        e = sc.expectations
+        exps = [x for x in (
+            expectation("settling_time_s", pm.settling_time_s, e.settling_time_s_max),
+            expectation("steady_state_attitude_error_deg", pm.steady_state_attitude_error_deg,
+                        e.steady_state_attitude_error_deg_max),
+            expectation("steady_state_rate_error_deg_s", pm.steady_state_rate_error_deg_s,
+                        e.steady_state_rate_error_deg_s_max),
+        ) if x is not None]
+        thr = self.plant.thrusters
+        return {
+            "scenario": sc.name, "scenario_file": sc.path, "mode": self.mode, "seed": self.seed,
+            "bus": self.bus_spec, "bitrate_bps": sc.bus.bitrate_bps,
+            "sim_time_s": sim_time_s, "wall_time_s": round(self.wall_s, 3),
+            "realtime_factor": round(sim_time_s / self.wall_s, 2) if self.wall_s > 0 else None,
+            "converged": pm.converged, "settling_band_deg": sc.expectations.settling_band_deg,
+            "settling_time_s": pm.settling_time_s,
+            "steady_state_attitude_error_deg": pm.steady_state_attitude_error_deg,
+            "steady_state_rate_error_deg_s": pm.steady_state_rate_error_deg_s,
+            "final_attitude_error_deg": pm.final_attitude_error_deg,
+            "propellant_kg": thr.total_propellant_kg,
+            "valve_openings": {"total": int(sum(thr.openings)), "per_thruster": list(thr.openings)},
+            "frames": frames,
+            "latency_us": {"sensor_to_command": latency_summary(self.latency_ns)},
+            "deadline_misses": {"bench_late": self.late_steps, "stalls": self.stalls,
+                                "fsw_overruns": int(self.fsw_status.get("Overruns", 0))},
+            "valve_watchdog_trips": self.watchdog_trips,
+            "faults": self.faults_log,
+            "expectations": exps,
+            "passed": all(x["pass"] for x in exps) and pm.converged,
+        }
+
+    def close(self, sim_time_s: float) -> dict[str, Any]:
+        """Finish files and write summary.json; returns the summary."""
+        self.trace.close()
+        self.telemetry.close()
+        self.pulses.close()
+        summary = self.summary(sim_time_s)
+        (self.run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n",
+                                                   encoding="utf-8")
+        return summary

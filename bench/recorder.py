@@ -1,0 +1,86 @@
+"""Run-folder writers that flush as they go: CAN trace (Vector ASC), telemetry CSV, events.
+
+* ``trace.asc`` — every frame the bench sent or received, in wire order, with its
+  modelled (lockstep) or measured (realtime) time of reception; Tx = sent by the bench.
+  Written through python-can's ``ASCWriter`` so python-can, Vector tools and SavvyCAN
+  read it; flushed once per control cycle, so a crash loses at most one cycle.
+* ``telemetry.csv`` — one row per telemetry sample (truth, sensors, estimates, commands);
+  a header row names each column with its unit; flushed per cycle.
+* ``events.jsonl`` — one JSON object per event (faults, watchdog, stalls), flushed per line.
+
+No clock is read here: every timestamp is passed in.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import IO, Any
+
+import can
+
+NS_PER_S = 1e9
+
+
+class TraceRecorder:
+    """CAN trace in Vector ASC format, plus an events log."""
+
+    def __init__(self, run_dir: Path) -> None:
+        self.path = run_dir / "trace.asc"
+        self._writer = can.ASCWriter(str(self.path), channel=1)
+        self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
+        self.frames_written = 0
+
+    def frame(self, msg: can.Message, t_ns: int, tx: bool) -> None:
+        """Record ``msg`` at time ``t_ns``; ``tx`` = sent by the bench."""
+        rec = can.Message(
+            timestamp=t_ns / NS_PER_S,
+            arbitration_id=msg.arbitration_id,
+            is_extended_id=msg.is_extended_id,
+            is_remote_frame=msg.is_remote_frame,
+            is_error_frame=msg.is_error_frame,
+            dlc=msg.dlc,
+            data=msg.data,
+            is_rx=not tx,
+            channel=0,
+        )
+        self._writer.on_message_received(rec)
+        self.frames_written += 1
+
+    def event(self, t_ns: int, kind: str, **fields: Any) -> None:
+        """Append one event line and flush it."""
+        self._events.write(json.dumps({"t_s": t_ns / NS_PER_S, "event": kind, **fields}) + "\n")
+        self._events.flush()
+
+    def flush(self) -> None:
+        """Flush the trace to disk."""
+        self._writer.file.flush()
+
+    def close(self) -> None:
+        """Finish both files."""
+        self._writer.stop()
+        self._events.close()
+
+
+class TelemetryWriter:
+    """``telemetry.csv`` with a fixed column list, flushed on demand."""
+
+    def __init__(self, path: Path, columns: list[str]) -> None:
+        self.path = path
+        self._file: IO[str] = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
+        self._csv = csv.writer(self._file)
+        self._csv.writerow(columns)
+        self.columns = columns
+
+    def row(self, values: list[float | int | str]) -> None:
+        """Append one row (same order as the columns)."""
+        self._csv.writerow(values)
+
+    def flush(self) -> None:
+        """Flush to disk."""
+        self._file.flush()
+
+    def close(self) -> None:
+        """Close the file."""
+        self._file.close()

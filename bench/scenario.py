@@ -1,0 +1,360 @@
+"""Scenario files (TOML) -> a validated, frozen :class:`Scenario`.
+
+A scenario says everything about one run: vehicle (actual and nominal mass properties),
+thrusters (a named layout or an explicit list, valve dynamics), sensors, bus, initial
+state, manoeuvre, the flight-software configuration (passed to the flight-software
+process as data, validated there), scheduled faults and expectations. Every bad field
+raises :class:`dbc.errors.ConfigError` naming the file, the dotted key, the value and what
+was expected; unknown keys are errors too. Nothing in a scenario is ever evaluated.
+
+Units are in the key names (``_s``, ``_m``, ``_deg``, ``_N`` ...). Angles are converted to
+radians here; quaternions are scalar-first q_BN.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from dbc.schema import Table
+from bench.valves.layouts import LAYOUTS
+from dbc.errors import ConfigError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+DEG_RAD = math.pi / 180.0
+SQRT_HOUR_S = 60.0  # sqrt(3600 s)
+UNIT_NORM_TOL = 1e-6
+FAULT_KINDS = ("stuck_closed", "stuck_open")
+MODES = ("lockstep", "realtime")
+
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class MassSpec:
+    mass_kg: float
+    inertia_B_kgm2: tuple[Vec3, Vec3, Vec3]
+
+
+@dataclass(frozen=True)
+class ThrusterSpec:
+    r_thr_B_m: Vec3
+    d_thr_B: Vec3
+
+
+@dataclass(frozen=True)
+class ValveSpec:
+    max_thrust_N: float
+    isp_s: float
+    open_delay_s: float
+    close_delay_s: float
+    rise_tau_s: float
+    tail_tau_s: float
+    min_on_s: float
+
+
+@dataclass(frozen=True)
+class GyroSpec:
+    arw_rad_sqrt_s: float
+    bias_rad_s: Vec3
+    bias_rw_rad_s_sqrt_s: float
+    lsb_rad_s: float
+    range_rad_s: float
+
+
+@dataclass(frozen=True)
+class AccelSpec:
+    vrw_m_s_sqrt_s: float
+    bias_m_s2: Vec3
+    lsb_m_s2: float
+    range_m_s2: float
+
+
+@dataclass(frozen=True)
+class StarTrackerSpec:
+    noise_cross_arcsec: float
+    noise_about_arcsec: float
+    boresight_B: Vec3
+
+
+@dataclass(frozen=True)
+class BusSpecCfg:
+    bitrate_bps: int
+    fsw_response_delay_s: float
+    stall_timeout_s: float
+    startup_timeout_s: float
+
+
+@dataclass(frozen=True)
+class FaultSpec:
+    t_s: float
+    kind: str
+    thruster: int
+    duration_s: float  # 0 = permanent
+
+
+@dataclass(frozen=True)
+class Expectations:
+    settling_band_deg: float
+    settling_time_s_max: float | None
+    steady_state_attitude_error_deg_max: float | None
+    steady_state_rate_error_deg_s_max: float | None
+    steady_state_window_s: float
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario. ``flight_sw`` is handed verbatim to the flight software."""
+
+    path: str
+    name: str
+    description: str
+    duration_s: float
+    seed: int
+    actual: MassSpec
+    nominal: MassSpec
+    thrusters: tuple[ThrusterSpec, ...]
+    valve: ValveSpec
+    gyro: GyroSpec
+    accel: AccelSpec
+    star_tracker: StarTrackerSpec
+    bus: BusSpecCfg
+    q0_BN: Quat
+    omega0_BN_B_rad_s: Vec3
+    r0_N_m: Vec3
+    v0_N_m_s: Vec3
+    q_target_BN: Quat
+    manoeuvre_start_s: float
+    flight_sw: dict[str, Any]
+    faults: tuple[FaultSpec, ...]
+    expectations: Expectations
+    raw: dict[str, Any] = field(repr=False, compare=False, default_factory=dict)
+
+    def fsw_config(self) -> dict[str, Any]:
+        """The flight-software configuration file content (nominal vehicle + [flight_sw])."""
+        return {
+            "source": self.path,
+            "vehicle": {
+                "mass_kg": self.nominal.mass_kg,
+                "inertia_B_kgm2": [list(r) for r in self.nominal.inertia_B_kgm2],
+            },
+            "thrusters": [
+                {"r_thr_B_m": list(t.r_thr_B_m), "d_thr_B": list(t.d_thr_B)} for t in self.thrusters
+            ],
+            "max_thrust_N": self.valve.max_thrust_N,
+            "min_on_s": self.valve.min_on_s,
+            "manoeuvre": {"q_target_BN": list(self.q_target_BN),
+                          "t_start_s": self.manoeuvre_start_s},
+            "flight_sw": self.flight_sw,
+        }
+
+
+def quat_from_euler_zyx(yaw_rad: float, pitch_rad: float, roll_rad: float) -> Quat:
+    """q_BN of a 3-2-1 (yaw, pitch, roll) rotation from N to B, scalar first, q0 >= 0."""
+    cy, sy = math.cos(yaw_rad / 2), math.sin(yaw_rad / 2)
+    cp, sp = math.cos(pitch_rad / 2), math.sin(pitch_rad / 2)
+    cr, sr = math.cos(roll_rad / 2), math.sin(roll_rad / 2)
+    q = (
+        cr * cp * cy + sr * sp * sy,
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+    )
+    return q if q[0] >= 0 else (-q[0], -q[1], -q[2], -q[3])
+
+
+def _unit(t: Table, key: str, n: int) -> tuple[float, ...]:
+    v = t.vector(key, n)
+    norm = math.sqrt(sum(x * x for x in v))
+    if abs(norm - 1.0) > UNIT_NORM_TOL:
+        raise t.error(key, list(v), f"a unit vector (norm 1 +- {UNIT_NORM_TOL}), norm is {norm:.6g}")
+    return v
+
+
+def _mass(t: Table) -> MassSpec:
+    m = t.number("mass_kg", lo=0.0, lo_open=True)
+    J = t.matrix3("inertia_B_kgm2")
+    for i in range(3):
+        for j in range(3):
+            if abs(J[i][j] - J[j][i]) > 1e-9 * max(1.0, abs(J[i][j])):
+                raise t.error("inertia_B_kgm2", [list(r) for r in J], "a symmetric matrix")
+    # positive definite: leading principal minors (Sylvester)
+    m1 = J[0][0]
+    m2 = J[0][0] * J[1][1] - J[0][1] * J[1][0]
+    m3 = (J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1])
+          - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0])
+          + J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]))
+    if min(m1, m2, m3) <= 0:
+        raise t.error("inertia_B_kgm2", [list(r) for r in J], "a positive-definite matrix")
+    return MassSpec(m, J)  # type: ignore[arg-type]
+
+
+def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
+    layout = t.string("layout", "explicit", choices=("explicit", *LAYOUTS))
+    if layout == "explicit":
+        items = t.tables("list")
+        if not items:
+            raise t.error("list", [], "at least one [[thrusters.list]] entry (or a layout)")
+        geo = []
+        for it in items:
+            geo.append(ThrusterSpec(it.vector("r_thr_B_m", 3), _unit(it, "d_thr_B", 3)))  # type: ignore[arg-type]
+            it.done()
+    else:
+        arm = t.number("arm_R_m", lo=0.0, lo_open=True)
+        length = t.number("length_L_m", lo=0.0, lo_open=True)
+        geo = [ThrusterSpec(r, d) for r, d in LAYOUTS[layout](arm, length)]
+    if len(geo) > 16:
+        raise t.error("list", len(geo), "at most 16 thrusters (THR_CMD_0..3 carry 16)")
+    v = ValveSpec(
+        max_thrust_N=t.number("max_thrust_N", lo=0.0, lo_open=True),
+        isp_s=t.number("isp_s", lo=0.0, lo_open=True),
+        open_delay_s=t.number("open_delay_s", lo=0.0, hi=0.1),
+        close_delay_s=t.number("close_delay_s", lo=0.0, hi=0.1),
+        rise_tau_s=t.number("rise_tau_s", lo=0.0, lo_open=True, hi=1.0),
+        tail_tau_s=t.number("tail_tau_s", lo=0.0, lo_open=True, hi=1.0),
+        min_on_s=t.number("min_on_s", lo=0.0, hi=0.1),
+    )
+    t.done()
+    return tuple(geo), v
+
+
+def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec]:
+    g = t.table("gyro")
+    gyro = GyroSpec(
+        arw_rad_sqrt_s=g.number("arw_deg_sqrt_h", lo=0.0) * DEG_RAD / SQRT_HOUR_S,
+        bias_rad_s=tuple(x * DEG_RAD / 3600.0 for x in g.vector("bias_deg_h", 3)),  # type: ignore[arg-type]
+        bias_rw_rad_s_sqrt_s=g.number("bias_rw_deg_h_sqrt_h", lo=0.0) * DEG_RAD / 3600.0 / SQRT_HOUR_S,
+        lsb_rad_s=g.number("lsb_rad_s", lo=0.0),
+        range_rad_s=g.number("range_rad_s", lo=0.0, lo_open=True),
+    )
+    g.done()
+    a = t.table("accelerometer")
+    accel = AccelSpec(
+        vrw_m_s_sqrt_s=a.number("vrw_m_s_sqrt_h", lo=0.0) / SQRT_HOUR_S,
+        bias_m_s2=tuple(x * 1e-6 * 9.80665 for x in a.vector("bias_ug", 3)),  # type: ignore[arg-type]
+        lsb_m_s2=a.number("lsb_m_s2", lo=0.0),
+        range_m_s2=a.number("range_m_s2", lo=0.0, lo_open=True),
+    )
+    a.done()
+    s = t.table("star_tracker")
+    st = StarTrackerSpec(
+        noise_cross_arcsec=s.number("noise_cross_arcsec", lo=0.0),
+        noise_about_arcsec=s.number("noise_about_arcsec", lo=0.0),
+        boresight_B=_unit(s, "boresight_B", 3),  # type: ignore[arg-type]
+    )
+    s.done()
+    t.done()
+    return gyro, accel, st
+
+
+def _faults(tables: list[Table], duration_s: float, n_thr: int) -> tuple[FaultSpec, ...]:
+    out = []
+    for f in tables:
+        spec = FaultSpec(
+            t_s=f.number("t_s", lo=0.0, hi=duration_s),
+            kind=f.string("kind", choices=FAULT_KINDS),
+            thruster=f.integer("thruster", lo=0),
+            duration_s=f.number("duration_s", 0.0, lo=0.0),
+        )
+        if spec.thruster >= n_thr:
+            raise f.error("thruster", spec.thruster, f"a thruster index 0..{n_thr - 1}")
+        f.done()
+        out.append(spec)
+    return tuple(sorted(out, key=lambda x: x.t_s))
+
+
+def _opt(t: Table, key: str) -> float | None:
+    return t.number(key, lo=0.0) if t.has(key) else None
+
+
+def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
+    """Validate parsed TOML ``data`` from file ``source`` into a :class:`Scenario`."""
+    root = Table(data, source)
+    sc = root.table("scenario")
+    name = sc.string("name")
+    description = sc.string("description", "")
+    duration_s = sc.number("duration_s", lo=0.0, lo_open=True, hi=1e6)
+    seed = sc.integer("seed", 0, lo=0)
+    sc.done()
+
+    vt = root.table("vehicle")
+    actual = _mass(vt)
+    nominal = _mass(vt.table("nominal")) if vt.has("nominal") else actual
+    vt.done()
+
+    thrusters, valve = _thrusters(root.table("thrusters"))
+    gyro, accel, st = _sensors(root.table("sensors"))
+
+    bt = root.table("bus", {})
+    bus = BusSpecCfg(
+        bitrate_bps=bt.integer("bitrate_bps", 1_000_000, lo=10_000),
+        fsw_response_delay_s=bt.number("fsw_response_delay_s", 0.001, lo=0.0, hi=0.1),
+        stall_timeout_s=bt.number("stall_timeout_s", 2.0, lo=0.0, lo_open=True),
+        startup_timeout_s=bt.number("startup_timeout_s", 60.0, lo=0.0, lo_open=True),
+    )
+    if bus.bitrate_bps > 1_000_000:
+        raise bt.error("bitrate_bps", bus.bitrate_bps, "at most 1000000 (classic CAN)")
+    bt.done()
+
+    it = root.table("initial", {})
+    q0 = _unit(it, "q_BN", 4) if it.has("q_BN") else (1.0, 0.0, 0.0, 0.0)
+    w0 = tuple(x * DEG_RAD for x in it.vector("omega_BN_B_deg_s", 3, [0.0, 0.0, 0.0]))
+    r0 = it.vector("r_N_m", 3, [0.0, 0.0, 0.0])
+    v0 = it.vector("v_N_m_s", 3, [0.0, 0.0, 0.0])
+    it.done()
+
+    mt = root.table("manoeuvre")
+    if mt.has("target_q_BN"):
+        q_target = _unit(mt, "target_q_BN", 4)
+    else:
+        yaw, pitch, roll = (x * DEG_RAD for x in mt.vector("target_euler_zyx_deg", 3))
+        q_target = quat_from_euler_zyx(yaw, pitch, roll)
+    t_start = mt.number("t_start_s", 0.0, lo=0.0, hi=duration_s)
+    mt.done()
+
+    fsw = root.raw("flight_sw", {})
+    if not isinstance(fsw, dict):
+        raise root.error("flight_sw", fsw, "a table")
+
+    faults = _faults(root.tables("faults"), duration_s, len(thrusters))
+
+    et = root.table("expectations", {})
+    exp = Expectations(
+        settling_band_deg=et.number("settling_band_deg", 0.5, lo=0.0, lo_open=True),
+        settling_time_s_max=_opt(et, "settling_time_s_max"),
+        steady_state_attitude_error_deg_max=_opt(et, "steady_state_attitude_error_deg_max"),
+        steady_state_rate_error_deg_s_max=_opt(et, "steady_state_rate_error_deg_s_max"),
+        steady_state_window_s=et.number("steady_state_window_s", 10.0, lo=0.0, lo_open=True,
+                                        hi=duration_s),
+    )
+    et.done()
+    root.done()
+    return Scenario(
+        path=source, name=name, description=description, duration_s=duration_s, seed=seed,
+        actual=actual, nominal=nominal, thrusters=thrusters, valve=valve, gyro=gyro,
+        accel=accel, star_tracker=st, bus=bus, q0_BN=q0, omega0_BN_B_rad_s=w0,  # type: ignore[arg-type]
+        r0_N_m=r0, v0_N_m_s=v0, q_target_BN=q_target, manoeuvre_start_s=t_start,  # type: ignore[arg-type]
+        flight_sw=fsw, faults=faults, expectations=exp, raw=data,
+    )
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate the scenario file at ``path``."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(str(p), "<file>", str(p), f"a readable scenario file ({exc.strerror})") from exc
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(str(p), "<syntax>", str(exc), "valid TOML") from exc
+    return parse_scenario(data, str(p))

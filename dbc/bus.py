@@ -1,0 +1,88 @@
+"""Bus specs -> python-can buses, for both processes and every tool.
+
+A bus spec is ``INTERFACE:CHANNEL`` with optional ``?key=value&...`` keyword arguments
+passed to :class:`can.Bus`, e.g. ``socketcan:vcan0``, ``virtual:test``, ``hilbus:default``
+(the portable cross-process bus of :mod:`dbc.hilbus`), ``pcan:PCAN_USBBUS1?bitrate=1000000``.
+The default is ``socketcan:vcan0`` where the kernel has that interface, else
+``hilbus:default``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from urllib.parse import parse_qsl
+
+import can
+
+from dbc.errors import BusError
+
+DEFAULT_SOCKETCAN_CHANNEL = "vcan0"
+PORTABLE_INTERFACE = "hilbus"
+PORTABLE_DEFAULT_CHANNEL = "default"
+SYS_NET = Path("/sys/class/net")
+
+
+@dataclass(frozen=True)
+class BusSpec:
+    """A parsed bus spec."""
+
+    interface: str
+    channel: str
+    options: tuple[tuple[str, str], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.interface or not self.channel:
+            raise BusError(f"bus spec {self}: interface and channel must both be given")
+
+    @classmethod
+    def parse(cls, spec: str) -> BusSpec:
+        """Parse ``INTERFACE:CHANNEL[?k=v&...]``; raises BusError naming the spec."""
+        head, _, query = spec.partition("?")
+        interface, sep, channel = head.partition(":")
+        if not sep or not interface or not channel:
+            raise BusError(
+                f"bus spec {spec!r}: expected INTERFACE:CHANNEL, e.g. socketcan:vcan0 "
+                f"or {PORTABLE_INTERFACE}:{PORTABLE_DEFAULT_CHANNEL}"
+            )
+        try:
+            options = tuple(parse_qsl(query, strict_parsing=bool(query)))
+        except ValueError as exc:
+            raise BusError(f"bus spec {spec!r}: malformed options {query!r}: {exc}") from None
+        return cls(interface, channel, options)
+
+    def __str__(self) -> str:
+        q = "&".join(f"{k}={v}" for k, v in self.options)
+        return f"{self.interface}:{self.channel}" + (f"?{q}" if q else "")
+
+    @property
+    def is_portable(self) -> bool:
+        """True for the project's own cross-process bus."""
+        return self.interface == PORTABLE_INTERFACE
+
+
+def _coerce(value: str) -> object:
+    for conv in (int, float):
+        try:
+            return conv(value)
+        except ValueError:
+            pass
+    return {"true": True, "false": False}.get(value.lower(), value)
+
+
+def default_bus_spec(sys_net: Path = SYS_NET) -> str:
+    """``socketcan:vcan0`` if the kernel has it, else the portable bus."""
+    if (sys_net / DEFAULT_SOCKETCAN_CHANNEL).exists():
+        return f"socketcan:{DEFAULT_SOCKETCAN_CHANNEL}"
+    return f"{PORTABLE_INTERFACE}:{PORTABLE_DEFAULT_CHANNEL}"
+
+
+def open_bus(spec: str | BusSpec, **kwargs: object) -> can.BusABC:
+    """Open the python-can bus named by ``spec``; raises BusError with the spec on failure."""
+    bs = spec if isinstance(spec, BusSpec) else BusSpec.parse(spec)
+    options = {k: _coerce(v) for k, v in bs.options}
+    options.update(kwargs)
+    try:
+        return can.Bus(interface=bs.interface, channel=bs.channel, **options)  # type: ignore[arg-type]
+    except (can.CanError, OSError, ValueError, ImportError, NotImplementedError) as exc:
+        raise BusError(f"cannot open bus {bs}: {exc}") from exc

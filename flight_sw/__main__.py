@@ -1,0 +1,56 @@
+"""Flight-software entry point: ``python -m flight_sw`` / ``thruster-hil-fsw``.
+
+Opens the bus, builds the flight computer from ``--config`` and runs it in lockstep (one
+cycle per SYNC) or realtime (own timer) until SIGTERM/SIGINT. ``--check`` only validates
+the configuration. Exit codes: 0 ok, 2 bad configuration or bus.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from dbc import load_database
+from dbc.bus import default_bus_spec, open_bus
+from dbc.codec import cycle_time_ns
+from dbc.errors import BusError, ConfigError
+from flight_sw.config import build_computer, load_config
+from flight_sw.node import FlightNode
+
+EXIT_BAD_INPUT = 2
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the flight software."""
+    p = argparse.ArgumentParser(prog="thruster-hil-fsw", description=__doc__.split("\n")[0])
+    p.add_argument("--config", required=True, help="flight-software configuration JSON")
+    p.add_argument("--bus", help="bus spec (default: socketcan:vcan0 if present, else hilbus:default)")
+    p.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
+    p.add_argument("--stats", help="write frame and cycle statistics JSON here")
+    p.add_argument("--check", action="store_true", help="validate the configuration and exit")
+    args = p.parse_args(argv)
+    db = load_database()
+    try:
+        computer = build_computer(
+            load_config(args.config), cycle_time_ns(db, "THR_CMD_0"), cycle_time_ns(db, "IMU_RATE"),
+            {"IMU_RATE": cycle_time_ns(db, "IMU_RATE"), "STR_QUAT": cycle_time_ns(db, "STR_QUAT")},
+        )
+        if args.check:
+            print(f"{args.config}: configuration ok")
+            return 0
+        bus = open_bus(args.bus or default_bus_spec())
+    except (ConfigError, BusError) as exc:
+        print(f"flight_sw: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    node = FlightNode(db, bus, computer, Path(args.stats) if args.stats else None)
+    node.install_signal_handlers()
+    try:
+        node.run(args.mode)
+    finally:
+        bus.shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

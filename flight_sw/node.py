@@ -1,0 +1,239 @@
+"""The flight-software process: CAN port and cycle scheduler around :class:`FlightComputer`.
+
+Frames in (checked on receipt by :class:`dbc.codec.FrameChecker`: ID, DLC, CRC, alive
+counter, range; freshness of SYNC by its cycle number): SYNC, IMU_RATE, IMU_ACCEL,
+STR_QUAT, THR_STATUS, BENCH_STATUS. Frames out: FSW_STATUS (also the boot heartbeat),
+FSW_ATT_EST, THR_CMD_0..3 (on-times of 4 thrusters each, the cycle number and the newest
+IMU_RATE counter used).
+
+Modes: ``lockstep`` — one control cycle per SYNC(k), at the simulation time it carries;
+``realtime`` — cycles on this process's own monotonic timer (period from the DBC), with
+overruns counted. Status and attitude telemetry go out every FSW_STATUS period. Runs
+until SIGTERM/SIGINT, then writes its statistics file and exits 0.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import signal
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import FrameType
+from typing import Any
+
+import can
+import numpy as np
+from cantools.database.can import Database
+
+from dbc.quaternion import pack_quaternion, unpack_quaternion
+from dbc.codec import Decoded, Encoder, FrameChecker, Reject, cycle_time_ns
+from flight_sw.clock import MonotonicClock
+from flight_sw.computer import CycleResult, FlightComputer
+
+THRUSTERS_PER_CMD_FRAME = 4
+HEARTBEAT_RETRY_S = 1.0
+CYCLE_MODULUS = 256
+STATUS_CYCLE_MODULUS = 65536
+OVERRUN_MAX = 255
+ON_TIME_LSB_S = 1e-4
+MS_PER_S = 1000
+NS_PER_MS = 1_000_000
+BENCH_FRAMES = frozenset(
+    {"SYNC", "IMU_RATE", "IMU_ACCEL", "STR_QUAT", "THR_STATUS", "BENCH_STATUS"}
+)
+
+
+class StopRequested(Exception):  # noqa: N818 - a request, not an error
+    """Raised by the signal handler to leave a blocking receive at once."""
+
+
+@dataclass
+class NodeStats:
+    """Counters the node reports at exit."""
+
+    cycles: int = 0
+    overruns: int = 0
+    sent: dict[str, int] = field(default_factory=dict)
+
+
+class FlightNode:
+    """Binds a FlightComputer to a bus."""
+
+    def __init__(self, db: Database, bus: can.BusABC, computer: FlightComputer,
+                 stats_path: Path | None = None) -> None:
+        self.db = db
+        self.bus = bus
+        self.fc = computer
+        self.encoder = Encoder(db)
+        self.checker = FrameChecker(db, accept=BENCH_FRAMES)
+        self.stats = NodeStats()
+        self.stats_path = stats_path
+        self.n_thr = len(computer.modulators)
+        self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
+        self.period_ns = cycle_time_ns(db, "THR_CMD_0")
+        self.status_every = max(1, cycle_time_ns(db, "FSW_STATUS") // self.period_ns)
+        self._stop = False
+        self._last_sync: int | None = None
+        self._pending_seen: set[str] = set()
+        self._sync_cycle = -1
+        self._last_flags = 0
+        self._last_sat = False
+        self._last_residual = 0.0
+
+    # -- signals -----------------------------------------------------------------
+    def install_signal_handlers(self) -> None:
+        """SIGTERM / SIGINT end the loop at once (even inside a blocking receive)."""
+        def _handler(signum: int, frame: FrameType | None) -> None:
+            self._stop = True
+            raise StopRequested(signum)
+        signal.signal(signal.SIGTERM, _handler)
+        signal.signal(signal.SIGINT, _handler)
+
+    def run(self, mode: str) -> None:
+        """Run ``mode`` ('lockstep' or 'realtime') until stopped; always writes statistics."""
+        try:
+            if mode == "lockstep":
+                self.run_lockstep()
+            else:
+                self.run_realtime()
+        except StopRequested:
+            pass
+        finally:
+            self.write_stats()
+
+    # -- transmit ----------------------------------------------------------------
+    def _send(self, name: str, signals: dict[str, float | int]) -> None:
+        self.bus.send(self.encoder.message(name, signals))
+        self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
+
+    def send_status(self, cycle: int) -> None:
+        """FSW_STATUS and FSW_ATT_EST."""
+        fc = self.fc
+        self._send("FSW_STATUS", {
+            "Mode": int(fc.mode), "Cycle": cycle % STATUS_CYCLE_MODULUS,
+            "Overruns": min(self.stats.overruns, OVERRUN_MAX),
+            "FdirFlags": self._last_flags, "AllocSaturated": int(self._last_sat),
+            "AllocResidual": min(self._last_residual, 12.75),
+        })
+        est = fc.estimator.estimate()
+        q = [float(x) for x in est.q_BN]
+        self._send("FSW_ATT_EST", {"Valid": int(est.initialised), **pack_quaternion(q)})
+
+    def send_commands(self, cycle: int, res: CycleResult) -> None:
+        """THR_CMD_0..m for one cycle (thrusters beyond the vehicle's count are 0)."""
+        max_on = self.period_ns / 1e9
+        for f in range(self.n_cmd_frames):
+            sig: dict[str, float | int] = {"Cycle": cycle % CYCLE_MODULUS, "ImuCounter": res.imu_counter}
+            for j in range(THRUSTERS_PER_CMD_FRAME):
+                k = f * THRUSTERS_PER_CMD_FRAME + j
+                on = res.on_time_s[k] if k < self.n_thr else 0.0
+                sig[f"OnTime_T{k:02d}"] = round(min(max(on, 0.0), max_on) / ON_TIME_LSB_S) * ON_TIME_LSB_S
+            self._send(f"THR_CMD_{f}", sig)
+
+    def run_cycle(self, cycle: int, t_ns: int) -> None:
+        """One control cycle at ``t_ns`` and its frames (status first, commands last)."""
+        res = self.fc.cycle(t_ns)
+        self._last_flags, self._last_sat, self._last_residual = res.fdir_flags, res.saturated, res.residual_Nm
+        self.stats.cycles += 1
+        if cycle % self.status_every == 0:
+            self.send_status(cycle)
+        self.send_commands(cycle, res)
+
+    # -- receive -----------------------------------------------------------------
+    def handle(self, d: Decoded, t_ns: int) -> None:
+        """Feed one checked sensor frame to the computer, stamped ``t_ns``."""
+        s = d.signals
+        if d.name == "IMU_RATE":
+            if s["Valid"]:
+                self.fc.on_imu_rate(t_ns, np.array((s["RateX"], s["RateY"], s["RateZ"])), d.counter, d.gap)
+                self._pending_seen.add("IMU_RATE")
+        elif d.name == "STR_QUAT":
+            if s["Valid"]:
+                self.fc.on_star_tracker(t_ns, np.array(unpack_quaternion(s)))
+                self._pending_seen.add("STR_QUAT")
+        elif d.name == "THR_STATUS":
+            self.fc.thr_status = s
+
+    def _heartbeat(self) -> None:
+        self._send("FSW_STATUS", {"Mode": 0, "Cycle": 0, "Overruns": 0, "FdirFlags": 0,
+                                  "AllocSaturated": 0, "AllocResidual": 0.0})
+
+    # -- loops -------------------------------------------------------------------
+    def run_lockstep(self) -> None:
+        """Cycle on SYNC frames until stopped."""
+        self._heartbeat()
+        synced = False
+        while not self._stop:
+            msg = self.bus.recv(timeout=HEARTBEAT_RETRY_S)
+            if msg is None:
+                if not synced:
+                    self._heartbeat()
+                continue
+            d = self.checker.check(msg)
+            if d is None:
+                continue
+            if d.name != "SYNC":
+                self.handle(d, self._last_sync or 0)
+                continue
+            cycle = int(d.signals["Cycle"])
+            if self._last_sync is not None and cycle <= self._sync_cycle:
+                self.checker.reject("SYNC", Reject.STALE)
+                continue
+            synced = True
+            t_ns = round(float(d.signals["SimTime"]) * MS_PER_S) * NS_PER_MS
+            if self._last_sync is None:
+                self.fc.watchdog.start(t_ns)
+            for name in self._pending_seen:
+                self.fc.watchdog.seen(name, t_ns)
+            self._pending_seen.clear()
+            self._last_sync, self._sync_cycle = t_ns, cycle
+            self.run_cycle(cycle, t_ns)
+        self.write_stats()
+
+    def run_realtime(self, clock: MonotonicClock | None = None) -> None:
+        """Cycle on this process's own timer until stopped."""
+        clock = clock or MonotonicClock()
+        self._heartbeat()
+        period = self.period_ns
+        next_ns = clock.now_ns() + period
+        cycle = 0
+        self.fc.watchdog.start(clock.now_ns())
+        while not self._stop:
+            now = clock.now_ns()
+            if now < next_ns:
+                msg = self.bus.recv(timeout=(next_ns - now) / 1e9)
+                if msg is not None:
+                    d = self.checker.check(msg)
+                    if d is not None:
+                        t = clock.now_ns()
+                        self.handle(d, t)
+                        for name in self._pending_seen:
+                            self.fc.watchdog.seen(name, t)
+                        self._pending_seen.clear()
+                continue
+            self.run_cycle(cycle, next_ns)
+            cycle += 1
+            next_ns += period
+            done = clock.now_ns()
+            while done >= next_ns:  # computation overran: skip the missed period(s)
+                self.stats.overruns += 1
+                next_ns += period
+            if cycle % (self.status_every * 10) == 0:
+                self.write_stats()
+        self.write_stats()
+
+    def write_stats(self) -> None:
+        """Write the node's statistics JSON (atomically) if a path was given."""
+        if self.stats_path is None:
+            return
+        data: dict[str, Any] = {
+            "cycles": self.stats.cycles,
+            "overruns": self.stats.overruns,
+            "sent": dict(sorted(self.stats.sent.items())),
+            "received": self.checker.summary(),
+            "mode": self.fc.mode.name,
+        }
+        tmp = self.stats_path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")
+        tmp.replace(self.stats_path)

@@ -1,0 +1,256 @@
+"""Back-to-back contract tests: every bus the project uses behaves the same way.
+
+Two buses A and B opened on the same channel through :func:`dbc.bus.open_bus` (like
+python-can's back2back tests): frames sent by A arrive at B unchanged and in order, B's
+frames arrive at A, and ``recv`` honours its timeout. Run for ``virtual`` and ``hilbus``
+always, and for ``socketcan:vcan0`` where the kernel has it. Plus :class:`dbc.bus.BusSpec`
+parsing and :func:`dbc.bus.default_bus_spec`.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+import threading
+import time
+import uuid
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import can
+import pytest
+
+from dbc.bus import BusSpec, default_bus_spec, open_bus
+from dbc.errors import BusError
+
+DEADLINE_S = 30.0
+TIMEOUT_SLACK_S = 0.5
+STREAM_N = 300  # more than hilbus queues per socket on Linux: exercises blocking sends
+VCAN = Path("/sys/class/net/vcan0")
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A bus under contract and what it can carry."""
+
+    interface: str
+    error_frames: bool = True  # socketcan delivers error frames only with an error filter
+    fd_frames: bool = True  # vcan0 has the classic MTU unless reconfigured
+
+    def spec(self) -> str:
+        if self.interface == "socketcan":
+            return "socketcan:vcan0"
+        return f"{self.interface}:ct-{uuid.uuid4().hex[:8]}"
+
+
+KINDS = [
+    pytest.param(Kind("virtual"), id="virtual"),
+    pytest.param(Kind("hilbus"), id="hilbus"),
+    pytest.param(
+        Kind("socketcan", error_frames=False, fd_frames=False),
+        id="socketcan",
+        marks=pytest.mark.socketcan,
+    ),
+]
+
+
+@pytest.fixture(params=KINDS)
+def pair(
+    request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch
+) -> Iterator[tuple[can.BusABC, can.BusABC, Kind]]:
+    """Buses A and B on one fresh channel of the bus kind under test."""
+    kind: Kind = request.param
+    if kind.interface == "socketcan" and not VCAN.exists():
+        pytest.skip("no SocketCAN interface vcan0 on this kernel (see tests/dbc smoke tests)")
+    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
+    spec = kind.spec()
+    try:
+        with open_bus(spec) as a, open_bus(spec) as b:
+            yield a, b, kind
+    finally:
+        shutil.rmtree(runtime, ignore_errors=True)
+
+
+def _frames(kind: Kind, base: int) -> list[can.Message]:
+    """A stream of varied frames with IDs unique to this test (base + i)."""
+    out = []
+    for i in range(STREAM_N):
+        n = i % 9
+        data = bytes((i * 7 + k) & 0xFF for k in range(n))
+        if i % 50 == 49:
+            out.append(can.Message(arbitration_id=base + i, is_remote_frame=True, dlc=n))
+        elif i % 2:
+            out.append(
+                can.Message(arbitration_id=(base + i) & 0x7FF, is_extended_id=False, data=data)
+            )
+        else:
+            out.append(can.Message(arbitration_id=base + i, data=data))
+    if kind.error_frames:
+        out.append(can.Message(arbitration_id=0x20000004, is_error_frame=True, data=bytes(8)))
+    if kind.fd_frames:
+        out.append(
+            can.Message(arbitration_id=base, is_fd=True, bitrate_switch=True, data=bytes(64))
+        )
+    return out
+
+
+def _key(m: can.Message) -> tuple[object, ...]:
+    return (
+        m.arbitration_id,
+        m.is_extended_id,
+        m.is_remote_frame,
+        m.is_error_frame,
+        m.is_fd,
+        m.bitrate_switch,
+        m.error_state_indicator,
+        m.dlc,
+        bytes(m.data),
+    )
+
+
+def _transfer(tx: can.BusABC, rx: can.BusABC, sent: list[can.Message]) -> list[can.Message]:
+    """Send ``sent`` on tx while a thread receives as many frames of them on rx."""
+    wanted = {_key(m) for m in sent}
+    got: list[can.Message] = []
+    failure: list[str] = []
+
+    def receive() -> None:
+        deadline = time.monotonic() + DEADLINE_S
+        while len(got) < len(sent):
+            left = deadline - time.monotonic()
+            if left <= 0:
+                failure.append(f"only {len(got)}/{len(sent)} frames within {DEADLINE_S} s")
+                return
+            m = rx.recv(timeout=left)
+            if m is not None and _key(m) in wanted:  # vcan0 may carry other traffic
+                got.append(m)
+
+    receiver = threading.Thread(target=receive, daemon=True)
+    receiver.start()
+    for m in sent:
+        tx.send(m, timeout=DEADLINE_S)
+    receiver.join(DEADLINE_S)
+    assert not receiver.is_alive() and not failure, failure
+    return got
+
+
+def test_a_to_b_unchanged_in_order(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
+    """Frames sent by A arrive at B with the same IDs, DLCs, data and flags, in order."""
+    a, b, kind = pair
+    sent = _frames(kind, 0x1A0000)
+    got = _transfer(a, b, sent)
+    assert [_key(m) for m in got] == [_key(m) for m in sent]
+    assert all(m.is_rx for m in got)
+
+
+def test_b_to_a_unchanged_in_order(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
+    """Frames sent by B arrive at A the same way."""
+    a, b, kind = pair
+    sent = _frames(kind, 0x1B0000)
+    got = _transfer(b, a, sent)
+    assert [_key(m) for m in got] == [_key(m) for m in sent]
+
+
+def test_sender_does_not_receive_its_own(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
+    """By default a bus does not receive what it sent itself."""
+    a, b, kind = pair
+    sent = _frames(kind, 0x1C0000)[:5]
+    _transfer(a, b, sent)
+    own = {_key(m) for m in sent}
+    while (m := a.recv(timeout=0)) is not None:
+        assert _key(m) not in own
+
+
+def test_recv_timeout_semantics(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
+    """recv(0) does not wait; recv(t) waits about t; a waiting frame returns at once."""
+    a, b, kind = pair
+    while b.recv(timeout=0) is not None:  # vcan0 may carry other traffic
+        pass
+    t0 = time.monotonic()
+    assert b.recv(timeout=0) is None
+    assert time.monotonic() - t0 < TIMEOUT_SLACK_S
+    if kind.interface != "socketcan":  # a shared vcan0 may not stay quiet for 0.2 s
+        t0 = time.monotonic()
+        assert b.recv(timeout=0.2) is None
+        assert 0.2 <= time.monotonic() - t0 < 0.2 + TIMEOUT_SLACK_S
+    a.send(can.Message(arbitration_id=0x1D0001, data=b"\x01"))
+    t0 = time.monotonic()
+    m = b.recv(timeout=DEADLINE_S)
+    assert m is not None and m.arbitration_id == 0x1D0001
+    assert time.monotonic() - t0 < TIMEOUT_SLACK_S
+
+
+# ---------------------------------------------------------------- bus specs
+
+
+@pytest.mark.parametrize(
+    ("spec", "interface", "channel", "options"),
+    [
+        ("socketcan:vcan0", "socketcan", "vcan0", ()),
+        ("hilbus:default", "hilbus", "default", ()),
+        ("pcan:PCAN_USBBUS1?bitrate=1000000", "pcan", "PCAN_USBBUS1", (("bitrate", "1000000"),)),
+        ("virtual:a:b", "virtual", "a:b", ()),
+    ],
+)
+def test_bus_spec_parse(
+    spec: str, interface: str, channel: str, options: tuple[object, ...]
+) -> None:
+    """Valid specs parse into interface, channel and options, and print back."""
+    bs = BusSpec.parse(spec)
+    assert (bs.interface, bs.channel, bs.options) == (interface, channel, options)
+    assert str(bs) == spec
+    assert bs.is_portable == (interface == "hilbus")
+
+
+@pytest.mark.parametrize("spec", ["vcan0", "", ":vcan0", "socketcan:", ":", "?bitrate=1"])
+def test_bus_spec_parse_errors(spec: str) -> None:
+    """A spec without INTERFACE:CHANNEL raises BusError naming the spec."""
+    with pytest.raises(BusError, match="expected INTERFACE:CHANNEL") as info:
+        BusSpec.parse(spec)
+    assert repr(spec) in str(info.value)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    raises=ValueError,
+    reason="dbc/bus.py: parse_qsl's ValueError for a malformed query escapes BusSpec.parse",
+)
+def test_bus_spec_malformed_options_raise_bus_error() -> None:
+    """A malformed ?query raises BusError (currently a bare ValueError)."""
+    with pytest.raises(BusError):
+        BusSpec.parse("socketcan:vcan0?bitrate")
+
+
+def test_default_bus_spec(tmp_path: Path) -> None:
+    """socketcan:vcan0 where sys_net has vcan0, else the portable hilbus:default."""
+    assert default_bus_spec(tmp_path) == "hilbus:default"
+    (tmp_path / "vcan0").mkdir()
+    assert default_bus_spec(tmp_path) == "socketcan:vcan0"
+
+
+def test_open_bus_errors_name_the_spec(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Unknown interfaces and bad hilbus channels raise BusError naming the problem."""
+    with pytest.raises(BusError, match="nosuchinterface:x"):
+        open_bus("nosuchinterface:x")
+    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
+    try:
+        with pytest.raises(BusError, match="'bad name'"):
+            open_bus("hilbus:bad name")
+    finally:
+        shutil.rmtree(runtime, ignore_errors=True)
+
+
+def test_open_bus_passes_options(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Spec options and keyword arguments reach the bus (receive_own_messages here)."""
+    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
+    try:
+        with open_bus(f"hilbus:ct-{uuid.uuid4().hex[:8]}?receive_own_messages=true") as bus:
+            bus.send(can.Message(arbitration_id=0x33))
+            m = bus.recv(timeout=DEADLINE_S)
+            assert m is not None and m.arbitration_id == 0x33 and not m.is_rx
+    finally:
+        shutil.rmtree(runtime, ignore_errors=True)

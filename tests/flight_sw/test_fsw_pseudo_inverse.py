@@ -1,0 +1,202 @@
+"""Tests of the bounded pseudo-inverse allocator on the seed-003 layout (torque and wrench)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import lsq_linear
+
+from dbc.errors import ConfigError
+from flight_sw.allocation.effectiveness import TORQUE_ROWS, effectiveness_matrix
+from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
+
+N_RANDOM = 500
+FEASIBLE_RESIDUAL_TOL = 1e-9  # brief: attainable demands reproduced to ≤ 1e-9
+DIRECTION_TOL = 1e-12  # 1 − cos(angle) between achieved and demanded on scaling
+LSQ_MATCH_TOL = 1e-9  # fallback result vs a direct scipy bounded least squares
+# Worst peak/T_max of the shifted pseudo-inverse over the vertices of [0, T_max]^8 for the
+# seed-003 layout (both torque-only and wrench): demands built with T ≤ T_max / 1.5 never
+# overflow, even without the exact repair.
+# worst peak of the shifted pseudo-inverse over vertex demands B·{0,1}^8 (torque, wrench)
+SEED003_SHIFT_OVERFLOW_BOUND = {"torque": 1.5, "wrench": 1.875}
+INFEASIBLE_SCALE = 50.0  # demands this many times the largest single-thruster effect
+
+
+def matrix(layout: tuple[np.ndarray, np.ndarray], rows: str) -> np.ndarray:
+    """Torque-only (3×8) or wrench (6×8) effectiveness matrix."""
+    b = effectiveness_matrix(*layout)
+    return b[TORQUE_ROWS] if rows == "torque" else b
+
+
+def assert_within_bounds(thrust: np.ndarray, tmax: float) -> None:
+    """Every thrust in [0, T_max]."""
+    assert np.all(thrust >= 0.0)
+    assert np.all(thrust <= tmax)
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_reproduces_every_feasible_demand_exactly(
+    layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """Random attainable demands B·T, T ∈ [0, T_max]^8 (vertices included), are reproduced."""
+    b = matrix(layout, rows)
+    alloc = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n))
+    plain = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n, exact_repair=False))
+    overflowed = 0
+    samples = np.vstack(
+        [
+            rng.uniform(0.0, max_thrust_n, (N_RANDOM, 8)),
+            max_thrust_n * rng.integers(0, 2, (N_RANDOM, 8)),  # vertices: the hard cases
+        ]
+    )
+    for t_true in samples:
+        demand = b @ t_true
+        res = alloc.allocate(demand)
+        assert res.residual_norm <= FEASIBLE_RESIDUAL_TOL
+        assert not res.saturated
+        assert_within_bounds(res.thrust_N, max_thrust_n)
+        overflowed += plain.allocate(demand).saturated
+    assert overflowed > 0  # the repair path was needed and exercised
+
+
+def test_known_counterexample_needs_the_repair(
+    layout: tuple[np.ndarray, np.ndarray], max_thrust_n: float
+) -> None:
+    """Thrusters 3, 4, 5, 6, 8 at T_max: the plain shift needs 1.25 T_max; the repair is exact."""
+    b = matrix(layout, "torque")
+    t_true = np.zeros(8)
+    t_true[[2, 3, 4, 5, 7]] = max_thrust_n
+    demand = b @ t_true
+    plain = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n, exact_repair=False))
+    res_plain = plain.allocate(demand)
+    assert res_plain.saturated
+    np.testing.assert_allclose(res_plain.achieved, demand / 1.25, atol=FEASIBLE_RESIDUAL_TOL)
+    res = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n)).allocate(demand)
+    assert res.residual_norm <= FEASIBLE_RESIDUAL_TOL and not res.saturated
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_plain_shift_is_exact_below_overflow_bound(
+    layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """Without repair, demands below the layout's overflow bound are reproduced by B⁺ d + shifts alone."""
+    b = matrix(layout, rows)
+    plain = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n, exact_repair=False))
+    tcap = max_thrust_n / SEED003_SHIFT_OVERFLOW_BOUND[rows]
+    for t_true in tcap * rng.integers(0, 2, (N_RANDOM, 8)):
+        res = plain.allocate(b @ t_true)
+        assert res.residual_norm <= FEASIBLE_RESIDUAL_TOL and not res.saturated
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_infeasible_demands_stay_in_bounds_and_keep_direction(
+    layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """Large random demands: thrusts in [0, T_max], flagged saturated, direction preserved."""
+    b = matrix(layout, rows)
+    alloc = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n))
+    scale = INFEASIBLE_SCALE * max_thrust_n * float(np.max(np.abs(b)))
+    # Direction is preserved for the attainable part of the demand: project onto range(B).
+    projector = b @ np.linalg.pinv(b)
+    for demand in scale * rng.normal(size=(N_RANDOM, b.shape[0])):
+        res = alloc.allocate(demand)
+        assert_within_bounds(res.thrust_N, max_thrust_n)
+        assert res.saturated
+        target = projector @ demand
+        cos = res.achieved @ target / (np.linalg.norm(res.achieved) * np.linalg.norm(target))
+        assert 1.0 - cos <= DIRECTION_TOL
+
+
+@pytest.mark.parametrize("masked", range(8))
+def test_mask_is_respected(
+    layout: tuple[np.ndarray, np.ndarray],
+    masked: int,
+    max_thrust_n: float,
+    rng: np.random.Generator,
+) -> None:
+    """A masked thruster gets exactly 0 N; demands feasible without it are still reproduced."""
+    b = matrix(layout, "torque")
+    mask = np.ones(8, dtype=bool)
+    mask[masked] = False
+    base = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n))
+    alloc = base.with_mask(mask)
+    assert alloc is not base and np.all(base.mask)
+    assert alloc.uses_null_space_shift
+    for t_true in rng.uniform(0.0, max_thrust_n, (N_RANDOM // 5, 8)) * mask:
+        res = alloc.allocate(b @ t_true)
+        assert res.thrust_N[masked] == 0.0
+        assert res.residual_norm <= FEASIBLE_RESIDUAL_TOL
+    for demand in 100.0 * rng.normal(size=(N_RANDOM // 5, 3)):
+        res = alloc.allocate(demand)
+        assert res.thrust_N[masked] == 0.0
+        assert_within_bounds(res.thrust_N, max_thrust_n)
+
+
+def test_lsq_fallback_without_positive_null_vector(
+    layout: tuple[np.ndarray, np.ndarray], max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """Wrench allocation with thruster 1 masked has no positive null vector: BVLS every call."""
+    b = matrix(layout, "wrench")
+    mask = np.ones(8, dtype=bool)
+    mask[0] = False
+    alloc = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n), mask)
+    assert not alloc.uses_null_space_shift and alloc.null_vector is None
+    for t_true in rng.uniform(0.0, max_thrust_n, (N_RANDOM // 5, 8)) * mask:
+        res = alloc.allocate(b @ t_true)
+        assert res.thrust_N[0] == 0.0
+        assert res.residual_norm <= FEASIBLE_RESIDUAL_TOL and not res.saturated
+    for demand in 100.0 * rng.normal(size=(N_RANDOM // 5, 6)):
+        res = alloc.allocate(demand)
+        assert res.thrust_N[0] == 0.0
+        assert_within_bounds(res.thrust_N, max_thrust_n)
+        direct = lsq_linear(b[:, 1:], demand, bounds=(0.0, max_thrust_n), method="bvls")
+        assert (
+            abs(res.residual_norm - np.linalg.norm(b[:, 1:] @ direct.x - demand)) <= LSQ_MATCH_TOL
+        )
+
+
+def test_torque_only_fallback_when_null_space_is_empty(
+    layout: tuple[np.ndarray, np.ndarray], max_thrust_n: float
+) -> None:
+    """Three independent thrusters (null space {0}) also fall back, and stay in bounds."""
+    b = matrix(layout, "torque")
+    mask = np.zeros(8, dtype=bool)
+    mask[[0, 2, 3]] = True
+    alloc = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n), mask)
+    assert not alloc.uses_null_space_shift
+    t_true = np.array([3.0, 0.0, 7.0, 11.0, 0.0, 0.0, 0.0, 0.0])
+    res = alloc.allocate(b @ t_true)
+    np.testing.assert_allclose(res.thrust_N, t_true, atol=FEASIBLE_RESIDUAL_TOL)
+    res = alloc.allocate(-(b @ t_true))  # needs negative thrust: bounded, saturated
+    assert res.saturated
+    assert_within_bounds(res.thrust_N, max_thrust_n)
+
+
+def test_zero_and_non_finite_demands(
+    layout: tuple[np.ndarray, np.ndarray], max_thrust_n: float
+) -> None:
+    """Zero demand gives zero thrust; NaN demand gives zero thrust flagged saturated."""
+    alloc = PseudoInverseAllocator(matrix(layout, "torque"), PseudoInverseParams(max_thrust_n))
+    res = alloc.allocate(np.zeros(3))
+    np.testing.assert_array_equal(res.thrust_N, np.zeros(8))
+    assert not res.saturated
+    res = alloc.allocate(np.array([np.nan, 0.0, 0.0]))
+    np.testing.assert_array_equal(res.thrust_N, np.zeros(8))
+    assert res.saturated and res.residual_norm == np.inf
+    with pytest.raises(ValueError):
+        res.thrust_N[0] = 1.0  # read-only result
+
+
+def test_configuration_is_validated(
+    layout: tuple[np.ndarray, np.ndarray], max_thrust_n: float
+) -> None:
+    """Bad thrust level, mask or matrix raise ConfigError."""
+    b = matrix(layout, "torque")
+    with pytest.raises(ConfigError):
+        PseudoInverseParams(0.0)
+    with pytest.raises(ConfigError):
+        PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n), [True] * 7)
+    with pytest.raises(ConfigError):
+        PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n), [1] * 8)  # type: ignore[list-item]
+    with pytest.raises(ConfigError):
+        PseudoInverseAllocator(np.full((3, 8), np.nan), PseudoInverseParams(max_thrust_n))
