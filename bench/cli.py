@@ -35,6 +35,7 @@ def _progress_printer() -> Any:
         elif frac - last[0] >= 0.1 or frac >= 1.0:
             last[0] = frac
             sys.stderr.write(f"progress {frac * 100:5.1f} % ({t_s:.1f}/{total_s:.1f} s sim)\n")
+
     return show
 
 
@@ -47,12 +48,15 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
         f"converged {s['converged']} | settling {s['settling_time_s']} s | "
         f"steady-state error {s['steady_state_attitude_error_deg']:.4f} deg, "
         f"{s['steady_state_rate_error_deg_s']:.4f} deg/s",
-        f"propellant {s['propellant_kg'] * 1000:.1f} g | valve openings {s['valve_openings']['total']}",
+        f"propellant {s['propellant_kg'] * 1000:.1f} g | "
+        f"valve openings {s['valve_openings']['total']}",
         f"latency sensor->command p50 {lat['p50']} us, p99 {lat['p99']} us, max {lat['max']} us "
         f"(n={lat['n']}) | deadline misses {s['deadline_misses']}",
     ]
     for e in s["expectations"]:
-        lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {e['value']} (max {e['max']})")
+        lines.append(
+            f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {e['value']} (max {e['max']})"
+        )
     if "error" in s:
         lines.append(f"  ERROR {s['error']}")
     lines.append(f"run folder: {out}")
@@ -71,14 +75,19 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
     bus = args.bus or default_bus_spec()
     BusSpec.parse(bus)
     opts = RunOptions(
-        mode=args.mode, bus=bus, seed=sc.seed if args.seed is None else args.seed,
+        mode=args.mode,
+        bus=bus,
+        seed=sc.seed if args.seed is None else args.seed,
         out=Path(args.out) if args.out else _default_out(sc.name),
         duration_s=args.duration if args.duration is not None else sc.duration_s,
         fsw_cmd=None if alone else (args.fsw_cmd or DEFAULT_FSW_CMD),
     )
     if alone:
-        print(f"bench waiting for flight software on {bus} (FSW_STATUS heartbeat), "
-              f"mode {opts.mode}, up to {sc.bus.startup_timeout_s} s", file=sys.stderr)
+        print(
+            f"bench waiting for flight software on {bus} (FSW_STATUS heartbeat), "
+            f"mode {opts.mode}, up to {sc.bus.startup_timeout_s} s",
+            file=sys.stderr,
+        )
     summary = run_scenario(sc, opts, _progress_printer())
     if sys.stderr.isatty():
         sys.stderr.write("\n")
@@ -104,19 +113,27 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``thruster-hil``."""
     p = argparse.ArgumentParser(prog="thruster-hil", description=__doc__.split("\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
-    for name, help_ in (("run", "run a scenario: bench + flight software"),
-                        ("bench", "run the bench alone; pair it with external flight software")):
+    for name, help_ in (
+        ("run", "run a scenario: bench + flight software"),
+        ("bench", "run the bench alone; pair it with external flight software"),
+    ):
         r = sub.add_parser(name, help=help_)
         r.add_argument("scenario", help="scenario TOML file")
         r.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
-        r.add_argument("--bus", help="bus spec INTERFACE:CHANNEL (default: socketcan:vcan0 if "
-                                     "present, else hilbus:default)")
+        r.add_argument(
+            "--bus",
+            help="bus spec INTERFACE:CHANNEL (default: socketcan:vcan0 if "
+            "present, else hilbus:default)",
+        )
         r.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
         r.add_argument("--out", help="run folder (default: runs/<scenario>-<time>)")
         r.add_argument("--duration", type=float, help="override the scenario duration [s]")
         if name == "run":
-            r.add_argument("--fsw-cmd", help="flight-software command; placeholders {bus} {mode} "
-                                             "{config} {stats} {run_dir}")
+            r.add_argument(
+                "--fsw-cmd",
+                help="flight-software command; placeholders {bus} {mode} "
+                "{config} {stats} {run_dir}",
+            )
     rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
     rp.add_argument("run_dir")
     return p

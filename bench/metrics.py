@@ -1,4 +1,4 @@
-"""Run metrics from truth telemetry: convergence, settling, steady-state errors, latency percentiles.
+"""Run metrics from truth telemetry: convergence, settling, steady-state errors, latency.
 
 Pure functions over arrays. Inputs: sample times [s], attitude error angle [deg] between
 true attitude and the manoeuvre's target, rate error [deg/s]. Settling time is the first
@@ -28,8 +28,12 @@ class PointingMetrics:
 
 
 def pointing_metrics(
-    t_s: np.ndarray, att_err_deg: np.ndarray, rate_err_deg_s: np.ndarray,
-    band_deg: float, window_s: float, t_start_s: float = 0.0,
+    t_s: np.ndarray,
+    att_err_deg: np.ndarray,
+    rate_err_deg_s: np.ndarray,
+    band_deg: float,
+    window_s: float,
+    t_start_s: float = 0.0,
 ) -> PointingMetrics:
     """Settling time (from ``t_start_s``), convergence and steady-state errors."""
     if len(t_s) == 0:
@@ -58,8 +62,12 @@ def latency_summary(samples_ns: list[int]) -> dict[str, Any]:
         return {"p50": None, "p99": None, "max": None, "n": 0}
     a = np.asarray(samples_ns, dtype=float) / 1e3
     p50, p99 = np.percentile(a, PERCENTILES)
-    return {"p50": round(float(p50), 3), "p99": round(float(p99), 3),
-            "max": round(float(a.max()), 3), "n": len(samples_ns)}
+    return {
+        "p50": round(float(p50), 3),
+        "p99": round(float(p99), 3),
+        "max": round(float(a.max()), 3),
+        "n": len(samples_ns),
+    }
 
 
 def expectation(name: str, value: float | None, limit: float | None) -> dict[str, Any] | None:

@@ -48,8 +48,9 @@ NS_PER_S = 1_000_000_000
 RAD_DEG = 180.0 / math.pi
 TELEMETRY_PERIOD_NS = 10_000_000
 SENSOR_ORDER = ("IMU_RATE", "IMU_ACCEL", "STR_QUAT", "THR_STATUS", "BENCH_STATUS")
-FSW_FRAMES = frozenset({"THR_CMD_0", "THR_CMD_1", "THR_CMD_2", "THR_CMD_3", "FSW_STATUS",
-                        "FSW_ATT_EST", "FAULT_CMD"})
+FSW_FRAMES = frozenset(
+    {"THR_CMD_0", "THR_CMD_1", "THR_CMD_2", "THR_CMD_3", "FSW_STATUS", "FSW_ATT_EST", "FAULT_CMD"}
+)
 HEALTH_WATCHDOG = 0x1
 HEALTH_FSW_SILENT = 0x2
 
@@ -60,8 +61,14 @@ def quat_error_deg(q: tuple[float, ...] | np.ndarray, r: tuple[float, ...]) -> f
     return 2.0 * math.acos(min(1.0, d)) * RAD_DEG
 
 
-def frame_table(db: Database, me: str, sent: dict[str, int],
-                received: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+def _step_ceil(t_ns: int) -> int:
+    """``t_ns`` rounded up to the integration grid."""
+    return -(-t_ns // STEP_NS) * STEP_NS
+
+
+def frame_table(
+    db: Database, me: str, sent: dict[str, int], received: dict[str, dict[str, Any]]
+) -> dict[str, dict[str, Any]]:
     """Per message: its sender, and what node ``me`` knows (what it sent, or what it received).
 
     The other side's counts are merged in by :func:`merge_peer_counts`.
@@ -69,8 +76,13 @@ def frame_table(db: Database, me: str, sent: dict[str, int],
     table: dict[str, dict[str, Any]] = {}
     for m in db.messages:
         sender = m.senders[0] if m.senders else "?"
-        table[m.name] = {"sender": sender, "sent": None, "received": None, "gaps": None,
-                         "rejected": {}}
+        table[m.name] = {
+            "sender": sender,
+            "sent": None,
+            "received": None,
+            "gaps": None,
+            "rejected": {},
+        }
     for name, n in sent.items():
         table[name]["sent"] = n
     for name, r in received.items():
@@ -79,8 +91,9 @@ def frame_table(db: Database, me: str, sent: dict[str, int],
     return table
 
 
-def merge_peer_counts(table: dict[str, dict[str, Any]], sent: dict[str, int],
-                      received: dict[str, dict[str, Any]]) -> None:
+def merge_peer_counts(
+    table: dict[str, dict[str, Any]], sent: dict[str, int], received: dict[str, dict[str, Any]]
+) -> None:
     """Fill in the peer's side: what it sent and what it received, by message."""
     for name, n in sent.items():
         if name in table:
@@ -104,9 +117,17 @@ class Clock:
 class BenchNode:
     """One bench run on one bus."""
 
-    def __init__(self, sc: Scenario, db: Database, bus: can.BusABC, run_dir: Path,
-                 mode: str, seed: int, bus_spec: str,
-                 progress: Callable[[float, float], None] | None = None) -> None:
+    def __init__(
+        self,
+        sc: Scenario,
+        db: Database,
+        bus: can.BusABC,
+        run_dir: Path,
+        mode: str,
+        seed: int,
+        bus_spec: str,
+        progress: Callable[[float, float], None] | None = None,
+    ) -> None:
         self.sc, self.db, self.bus, self.run_dir = sc, db, bus, run_dir
         self.mode, self.seed, self.bus_spec = mode, seed, bus_spec
         self.progress = progress
@@ -114,14 +135,16 @@ class BenchNode:
         self.checker = FrameChecker(db, accept=FSW_FRAMES)
         self.period_ns = cycle_time_ns(db, "THR_CMD_0")
         self.sensor_period_ns = {n: cycle_time_ns(db, n) for n in SENSOR_ORDER}
+        self.tick_ns = math.gcd(TELEMETRY_PERIOD_NS, *self.sensor_period_ns.values())
         self.plant = Plant(sc, seed, self.sensor_period_ns["IMU_RATE"])
         self.n_thr = len(sc.thrusters)
         self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
         self.arbiter = BusArbiter(sc.bus.bitrate_bps)
         self.trace = TraceRecorder(run_dir)
         self.telemetry = TelemetryWriter(run_dir / "telemetry.csv", self._columns())
-        self.pulses = TelemetryWriter(run_dir / "valve_pulses.csv",
-                                      ["t_on_s", "t_off_s", "thruster"])
+        self.pulses = TelemetryWriter(
+            run_dir / "valve_pulses.csv", ["t_on_s", "t_off_s", "thruster"]
+        )
         self.sent: dict[str, int] = {}
         self.queue: list[tuple[int, int, str, dict[str, float | int]]] = []
         self.imu_tx_ns: dict[int, int] = {}
@@ -151,10 +174,30 @@ class BenchNode:
 
     # -- telemetry ---------------------------------------------------------------
     def _columns(self) -> list[str]:
-        cols = ["t_s", "q0", "q1", "q2", "q3", "wx_rad_s", "wy_rad_s", "wz_rad_s",
-                "rx_m", "ry_m", "rz_m", "vx_m_s", "vy_m_s", "vz_m_s",
-                "att_err_deg", "rate_err_deg_s",
-                "fsw_q0", "fsw_q1", "fsw_q2", "fsw_q3", "fsw_est_err_deg", "fsw_mode"]
+        cols = [
+            "t_s",
+            "q0",
+            "q1",
+            "q2",
+            "q3",
+            "wx_rad_s",
+            "wy_rad_s",
+            "wz_rad_s",
+            "rx_m",
+            "ry_m",
+            "rz_m",
+            "vx_m_s",
+            "vy_m_s",
+            "vz_m_s",
+            "att_err_deg",
+            "rate_err_deg_s",
+            "fsw_q0",
+            "fsw_q1",
+            "fsw_q2",
+            "fsw_q3",
+            "fsw_est_err_deg",
+            "fsw_mode",
+        ]
         cols += [f"thrust_T{k:02d}_N" for k in range(len(self.sc.thrusters))]
         return cols + ["propellant_kg"]
 
@@ -194,19 +237,29 @@ class BenchNode:
             sig: dict[str, float | int] = {}
             for k, (cmd, opn, cur) in enumerate(p.thrusters.status(t_ns)):
                 sig[f"Cmd_T{k:02d}"], sig[f"Open_T{k:02d}"], sig[f"Current_T{k:02d}"] = (
-                    int(cmd), int(opn), int(cur))
+                    int(cmd),
+                    int(opn),
+                    int(cur),
+                )
             for k in range(self.n_thr, 16):
                 sig[f"Cmd_T{k:02d}"] = sig[f"Open_T{k:02d}"] = sig[f"Current_T{k:02d}"] = 0
             return sig
         # BENCH_STATUS
         health = (HEALTH_WATCHDOG if self.watchdog_tripped else 0) | (
-            HEALTH_FSW_SILENT if self.fsw_silent else 0)
-        return {"SimTime": t_ns / NS_PER_S, "ActiveFaults": len(self.active_faults), "Health": health}
+            HEALTH_FSW_SILENT if self.fsw_silent else 0
+        )
+        return {
+            "SimTime": t_ns / NS_PER_S,
+            "ActiveFaults": len(self.active_faults),
+            "Health": health,
+        }
 
     def _queue_due(self, t_ns: int) -> None:
         for name in SENSOR_ORDER:
             if t_ns % self.sensor_period_ns[name] == 0:
-                self.queue.append((t_ns, self.encoder.frame_id(name), name, self._sample(name, t_ns)))
+                self.queue.append(
+                    (t_ns, self.encoder.frame_id(name), name, self._sample(name, t_ns))
+                )
 
     # -- faults and watchdog -----------------------------------------------------
     def _faults_due(self, t_ns: int) -> None:
@@ -214,8 +267,13 @@ class BenchNode:
             f = self.pending_faults.pop(0)
             self.plant.thrusters.set_fault(f.thruster, f.kind)
             self.active_faults[f.thruster] = f.kind
-            rec = {"t_s": t_ns / NS_PER_S, "kind": f.kind, "thruster": f.thruster,
-                   "duration_s": f.duration_s, "source": "scenario"}
+            rec = {
+                "t_s": t_ns / NS_PER_S,
+                "kind": f.kind,
+                "thruster": f.thruster,
+                "duration_s": f.duration_s,
+                "source": "scenario",
+            }
             self.faults_log.append(rec)
             self.trace.event(t_ns, "fault_injected", **rec)
             if f.duration_s > 0:
@@ -227,35 +285,71 @@ class BenchNode:
             self.trace.event(t_ns, "fault_cleared", thruster=clear[1])
 
     def _watchdog(self, t_ns: int) -> None:
-        if not self.watchdog_tripped and t_ns - self.last_cmd_ns > WATCHDOG_PERIODS * self.period_ns:
+        if (
+            not self.watchdog_tripped
+            and t_ns - self.last_cmd_ns > WATCHDOG_PERIODS * self.period_ns
+        ):
             self.plant.thrusters.close_all(t_ns)
             self.watchdog_tripped = True
             self.watchdog_trips += 1
-            self.trace.event(t_ns, "valve_watchdog", action="all valves closed",
-                             last_command_s=self.last_cmd_ns / NS_PER_S)
+            self.trace.event(
+                t_ns,
+                "valve_watchdog",
+                action="all valves closed",
+                last_command_s=self.last_cmd_ns / NS_PER_S,
+            )
 
     # -- integration -------------------------------------------------------------
+    def _next_event_ns(self, t_ns: int) -> int:
+        """The next time (after ``t_ns``) at which something besides integration happens."""
+        nxt = (t_ns // self.tick_ns + 1) * self.tick_ns
+        if self.pending_faults:
+            nxt = min(nxt, _step_ceil(round(self.pending_faults[0].t_s * NS_PER_S)))
+        for t_clear, _ in self.fault_clears:
+            nxt = min(nxt, _step_ceil(t_clear))
+        if not self.watchdog_tripped:
+            nxt = min(
+                nxt,
+                (self.last_cmd_ns + WATCHDOG_PERIODS * self.period_ns) // STEP_NS * STEP_NS
+                + STEP_NS,
+            )
+        return max(nxt, t_ns + STEP_NS)
+
     def integrate_to(self, t_end_ns: int) -> None:
-        """Advance the plant, sampling sensors and telemetry on the way."""
+        """Advance the plant, sampling sensors and telemetry on the way.
+
+        In lockstep, sensor frames go out as soon as they are sampled (still before the
+        SYNC that follows them), so the flight software digests them while the bench
+        integrates.
+        """
         while self.plant.t_ns < t_end_ns:
-            t = self.plant.t_ns + STEP_NS
+            t = min(t_end_ns, self._next_event_ns(self.plant.t_ns))
             self.plant.advance_to(t)
             self._faults_due(t)
             self._watchdog(t)
             if t % TELEMETRY_PERIOD_NS == 0:
                 self._telemetry_row(t)
             self._queue_due(t)
+            if self.queue and self.mode == "lockstep":
+                self._send_queue()
 
     # -- transmit / receive --------------------------------------------------------
-    def _send(self, name: str, signals: dict[str, float | int], ready_ns: int,
-              realtime_ns: int | None = None) -> can.Message:
+    def _send(
+        self,
+        name: str,
+        signals: dict[str, float | int],
+        ready_ns: int,
+        realtime_ns: int | None = None,
+    ) -> can.Message:
         msg = self.encoder.message(name, signals)
         self.bus.send(msg)
         self.sent[name] = self.sent.get(name, 0) + 1
         if realtime_ns is not None:
             self.trace.frame(msg, realtime_ns, tx=True)
         else:
-            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data)))
+            seq = self.arbiter.submit(
+                ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data))
+            )
             self._wire_pending[seq] = (msg, True)
         if name == "IMU_RATE":
             self.imu_tx_ns[msg.data[1] & 0x0F] = ready_ns if realtime_ns is None else realtime_ns
@@ -303,25 +397,29 @@ class BenchNode:
         deadline = time.monotonic() + self.sc.bus.startup_timeout_s
         while time.monotonic() < deadline:
             if self.fsw_alive is not None and not self.fsw_alive():
-                raise RunError("the flight-software process exited before its first frame "
-                               "(see fsw.log in the run folder)")
+                raise RunError(
+                    "the flight-software process exited before its first frame "
+                    "(see fsw.log in the run folder)"
+                )
             msg = self.bus.recv(timeout=min(STARTUP_POLL_S, max(0.0, deadline - time.monotonic())))
             if msg is None:
                 continue
             d = self.checker.check(msg)
             if d is not None:
                 self.trace.frame(msg, 0, tx=False)
-                self._on_fsw_frame(d.name, d.signals)  # type: ignore[arg-type]
+                self._on_fsw_frame(d.name, d.signals)
                 return
         raise RunError(
             f"no flight software on bus {self.bus_spec} within "
-            f"{self.sc.bus.startup_timeout_s} s (expected its FSW_STATUS heartbeat)")
+            f"{self.sc.bus.startup_timeout_s} s (expected its FSW_STATUS heartbeat)"
+        )
 
     def run_lockstep(self, duration_s: float) -> None:
         """Lockstep run of ``duration_s`` simulated seconds."""
         n_cycles = round(duration_s * NS_PER_S / self.period_ns)
         delay_ns = round(self.sc.bus.fsw_response_delay_s * NS_PER_S)
         self.wait_for_fsw()
+        self.trace.event(0, "run_started", mode=self.mode, seed=self.seed, cycles=n_cycles)
         wall0 = time.monotonic()
         self._queue_due(0)
         self._telemetry_row(0)
@@ -340,6 +438,7 @@ class BenchNode:
         self._flush_wire()
         self.queue.clear()
         self.wall_s = time.monotonic() - wall0
+        self.trace.event(self.plant.t_ns, "run_finished", stalls=self.stalls)
 
     def _collect_lockstep(self, k: int, ready_ns: int) -> None:
         """Receive this cycle's commands, deliver them at their modelled arrival."""
@@ -357,9 +456,11 @@ class BenchNode:
             d = self.checker.check(msg)
             if d is None:
                 continue
-            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data)))
+            seq = self.arbiter.submit(
+                ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data))
+            )
             self._wire_pending[seq] = (msg, False)
-            s: dict[str, float] = d.signals  # type: ignore[assignment]
+            s: dict[str, float] = d.signals
             if d.name.startswith("THR_CMD_"):
                 if int(s["Cycle"]) != k % CYCLE_MODULUS:
                     self.checker.reject(d.name, Reject.STALE)
@@ -400,6 +501,7 @@ class BenchNode:
     def run_realtime(self, duration_s: float, clock: Clock | None = None) -> None:
         """Wall-clock-paced run of ``duration_s`` seconds."""
         self.wait_for_fsw()
+        self.trace.event(0, "run_started", mode=self.mode, seed=self.seed)
         clock = clock or Clock()
         end_ns = round(duration_s * NS_PER_S)
         self._queue_due(0)
@@ -427,13 +529,14 @@ class BenchNode:
                     self.progress(self.plant.t_ns / NS_PER_S, duration_s)
                 next_progress += 5 * self.period_ns
         self.wall_s = clock.now_ns() / NS_PER_S
+        self.trace.event(self.plant.t_ns, "run_finished", late_steps=self.late_steps)
 
     def _on_realtime_frame(self, msg: can.Message, t_ns: int) -> None:
         d = self.checker.check(msg)
         if d is None:
             return
         self.trace.frame(msg, t_ns, tx=False)
-        s: dict[str, float] = d.signals  # type: ignore[assignment]
+        s: dict[str, float] = d.signals
         if d.name.startswith("THR_CMD_"):
             t_apply = max(t_ns, self.plant.t_ns)
             self._apply_command(s, int(d.name[-1]), t_apply)
@@ -450,25 +553,46 @@ class BenchNode:
     def summary(self, sim_time_s: float) -> dict[str, Any]:
         """summary.json content from the bench's side."""
         sc = self.sc
-        pm = pointing_metrics(np.asarray(self.tel_t), np.asarray(self.tel_err),
-                              np.asarray(self.tel_rate_err), sc.expectations.settling_band_deg,
-                              sc.expectations.steady_state_window_s, sc.manoeuvre_start_s)
+        pm = pointing_metrics(
+            np.asarray(self.tel_t),
+            np.asarray(self.tel_err),
+            np.asarray(self.tel_rate_err),
+            sc.expectations.settling_band_deg,
+            sc.expectations.steady_state_window_s,
+            sc.manoeuvre_start_s,
+        )
         frames = frame_table(self.db, "BENCH", self.sent, self.checker.summary())
         e = sc.expectations
-        exps = [x for x in (
-            expectation("settling_time_s", pm.settling_time_s, e.settling_time_s_max),
-            expectation("steady_state_attitude_error_deg", pm.steady_state_attitude_error_deg,
-                        e.steady_state_attitude_error_deg_max),
-            expectation("steady_state_rate_error_deg_s", pm.steady_state_rate_error_deg_s,
-                        e.steady_state_rate_error_deg_s_max),
-        ) if x is not None]
+        exps = [
+            x
+            for x in (
+                expectation("settling_time_s", pm.settling_time_s, e.settling_time_s_max),
+                expectation(
+                    "steady_state_attitude_error_deg",
+                    pm.steady_state_attitude_error_deg,
+                    e.steady_state_attitude_error_deg_max,
+                ),
+                expectation(
+                    "steady_state_rate_error_deg_s",
+                    pm.steady_state_rate_error_deg_s,
+                    e.steady_state_rate_error_deg_s_max,
+                ),
+            )
+            if x is not None
+        ]
         thr = self.plant.thrusters
         return {
-            "scenario": sc.name, "scenario_file": sc.path, "mode": self.mode, "seed": self.seed,
-            "bus": self.bus_spec, "bitrate_bps": sc.bus.bitrate_bps,
-            "sim_time_s": sim_time_s, "wall_time_s": round(self.wall_s, 3),
+            "scenario": sc.name,
+            "scenario_file": sc.path,
+            "mode": self.mode,
+            "seed": self.seed,
+            "bus": self.bus_spec,
+            "bitrate_bps": sc.bus.bitrate_bps,
+            "sim_time_s": sim_time_s,
+            "wall_time_s": round(self.wall_s, 3),
             "realtime_factor": round(sim_time_s / self.wall_s, 2) if self.wall_s > 0 else None,
-            "converged": pm.converged, "settling_band_deg": sc.expectations.settling_band_deg,
+            "converged": pm.converged,
+            "settling_band_deg": sc.expectations.settling_band_deg,
             "settling_time_s": pm.settling_time_s,
             "steady_state_attitude_error_deg": pm.steady_state_attitude_error_deg,
             "steady_state_rate_error_deg_s": pm.steady_state_rate_error_deg_s,
@@ -477,8 +601,11 @@ class BenchNode:
             "valve_openings": {"total": int(sum(thr.openings)), "per_thruster": list(thr.openings)},
             "frames": frames,
             "latency_us": {"sensor_to_command": latency_summary(self.latency_ns)},
-            "deadline_misses": {"bench_late": self.late_steps, "stalls": self.stalls,
-                                "fsw_overruns": int(self.fsw_status.get("Overruns", 0))},
+            "deadline_misses": {
+                "bench_late": self.late_steps,
+                "stalls": self.stalls,
+                "fsw_overruns": int(self.fsw_status.get("Overruns", 0)),
+            },
             "valve_watchdog_trips": self.watchdog_trips,
             "faults": self.faults_log,
             "expectations": exps,
@@ -491,6 +618,7 @@ class BenchNode:
         self.telemetry.close()
         self.pulses.close()
         summary = self.summary(sim_time_s)
-        (self.run_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n",
-                                                   encoding="utf-8")
+        (self.run_dir / "summary.json").write_text(
+            json.dumps(summary, indent=2) + "\n", encoding="utf-8"
+        )
         return summary

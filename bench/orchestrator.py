@@ -57,8 +57,10 @@ class RunOptions:
 
 def _fsw_argv(template: str, opts: RunOptions, config: Path, stats: Path) -> list[str]:
     try:
-        return [a.format(bus=opts.bus, mode=opts.mode, config=config, stats=stats, run_dir=opts.out)
-                for a in shlex.split(template)]
+        return [
+            a.format(bus=opts.bus, mode=opts.mode, config=config, stats=stats, run_dir=opts.out)
+            for a in shlex.split(template)
+        ]
     except (KeyError, IndexError, ValueError) as exc:
         raise RunError(f"--fsw-cmd {template!r}: bad placeholder ({exc})") from exc
 
@@ -74,8 +76,9 @@ def _stop(proc: subprocess.Popen[bytes]) -> int | None:
     return proc.returncode
 
 
-def run_scenario(sc: Scenario, opts: RunOptions,
-                 progress: Callable[[float, float], None] | None = None) -> dict[str, Any]:
+def run_scenario(
+    sc: Scenario, opts: RunOptions, progress: Callable[[float, float], None] | None = None
+) -> dict[str, Any]:
     """Run ``sc``; returns the summary (also written to ``opts.out/summary.json``)."""
     out = opts.out
     out.mkdir(parents=True, exist_ok=True)
@@ -92,8 +95,12 @@ def run_scenario(sc: Scenario, opts: RunOptions,
         if opts.fsw_cmd is not None:
             log = open(out / "fsw.log", "wb")  # noqa: SIM115 - handed to the child
             env = dict(os.environ, PYTHONUNBUFFERED="1")
-            proc = subprocess.Popen(_fsw_argv(opts.fsw_cmd, opts, config, stats),
-                                    stdout=log, stderr=subprocess.STDOUT, env=env)
+            proc = subprocess.Popen(
+                _fsw_argv(opts.fsw_cmd, opts, config, stats),
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                env=env,
+            )
             log.close()
             node.fsw_alive = lambda: proc is not None and proc.poll() is None
         if opts.mode == "lockstep":
@@ -107,13 +114,16 @@ def run_scenario(sc: Scenario, opts: RunOptions,
         bus.shutdown()
     summary = node.close(opts.duration_s if error is None else node.plant.t_ns / 1e9)
     summary["fsw"] = _fsw_report(stats, fsw_rc, out)
-    merge_peer_counts(summary["frames"], summary["fsw"].get("sent", {}),
-                      summary["fsw"].get("received", {}))
+    merge_peer_counts(
+        summary["frames"], summary["fsw"].get("sent", {}), summary["fsw"].get("received", {})
+    )
     if isinstance(summary["deadline_misses"], dict):
         summary["deadline_misses"]["fsw_overruns"] = max(
-            summary["deadline_misses"]["fsw_overruns"], summary["fsw"].get("overruns", 0))
+            summary["deadline_misses"]["fsw_overruns"], summary["fsw"].get("overruns", 0)
+        )
         summary["deadline_misses"]["total"] = sum(
-            v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns"))
+            v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns")
+        )
     if error is not None:
         summary["error"] = f"{type(error).__name__}: {error}"
         summary["passed"] = False
@@ -137,6 +147,10 @@ def _fsw_report(stats: Path, rc: int | None, out: Path) -> dict[str, Any]:
         rep["stats_error"] = "flight software wrote no statistics"
     if rc not in (0, None):
         log = out / "fsw.log"
-        tail = log.read_text(encoding="utf-8", errors="replace").splitlines()[-5:] if log.exists() else []
+        tail = (
+            log.read_text(encoding="utf-8", errors="replace").splitlines()[-5:]
+            if log.exists()
+            else []
+        )
         rep["log_tail"] = tail
     return rep

@@ -33,27 +33,52 @@ class Plant:
         self.state = make_state(sc.q0_BN, sc.omega0_BN_B_rad_s, sc.r0_N_m, sc.v0_N_m_s)
         v = sc.valve
         params = ValveParams(
-            max_thrust_N=v.max_thrust_N, isp_s=v.isp_s, open_delay_s=v.open_delay_s,
-            close_delay_s=v.close_delay_s, rise_tau_s=v.rise_tau_s, tail_tau_s=v.tail_tau_s,
+            max_thrust_N=v.max_thrust_N,
+            isp_s=v.isp_s,
+            open_delay_s=v.open_delay_s,
+            close_delay_s=v.close_delay_s,
+            rise_tau_s=v.rise_tau_s,
+            tail_tau_s=v.tail_tau_s,
             min_on_s=v.min_on_s,
         )
         self.thrusters = ThrusterSet(
             [ThrusterGeometry(t.r_thr_B_m, t.d_thr_B) for t in sc.thrusters], params
         )
-        rng_g, rng_a, rng_s = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3))
+        rng_g, rng_a, rng_s = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
+        )
         g = sc.gyro
-        self.gyro = Gyro(GyroParams(
-            arw_rad_sqrt_s=g.arw_rad_sqrt_s, bias_rad_s=g.bias_rad_s,
-            bias_rw_rad_s_sqrt_s=g.bias_rw_rad_s_sqrt_s, lsb_rad_s=g.lsb_rad_s,
-            range_rad_s=g.range_rad_s, period_s=imu_period_ns / NS_PER_S), rng_g)
+        self.gyro = Gyro(
+            GyroParams(
+                arw_rad_sqrt_s=g.arw_rad_sqrt_s,
+                bias_rad_s=g.bias_rad_s,
+                bias_rw_rad_s_sqrt_s=g.bias_rw_rad_s_sqrt_s,
+                lsb_rad_s=g.lsb_rad_s,
+                range_rad_s=g.range_rad_s,
+                period_s=imu_period_ns / NS_PER_S,
+            ),
+            rng_g,
+        )
         a = sc.accel
-        self.accel = Accelerometer(AccelerometerParams(
-            vrw_m_s_sqrt_s=a.vrw_m_s_sqrt_s, bias_m_s2=a.bias_m_s2, lsb_m_s2=a.lsb_m_s2,
-            range_m_s2=a.range_m_s2, period_s=imu_period_ns / NS_PER_S), rng_a)
+        self.accel = Accelerometer(
+            AccelerometerParams(
+                vrw_m_s_sqrt_s=a.vrw_m_s_sqrt_s,
+                bias_m_s2=a.bias_m_s2,
+                lsb_m_s2=a.lsb_m_s2,
+                range_m_s2=a.range_m_s2,
+                period_s=imu_period_ns / NS_PER_S,
+            ),
+            rng_a,
+        )
         s = sc.star_tracker
-        self.star = StarTracker(StarTrackerParams(
-            noise_cross_arcsec=s.noise_cross_arcsec, noise_about_arcsec=s.noise_about_arcsec,
-            boresight_B=s.boresight_B), rng_s)
+        self.star = StarTracker(
+            StarTrackerParams(
+                noise_cross_arcsec=s.noise_cross_arcsec,
+                noise_about_arcsec=s.noise_about_arcsec,
+                boresight_B=s.boresight_B,
+            ),
+            rng_s,
+        )
         self.t_ns = 0
 
     def advance_to(self, t_end_ns: int) -> None:

@@ -13,8 +13,8 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
 RAD_DEG = 180.0 / np.pi
 DPI = 110
@@ -27,7 +27,11 @@ def _read_csv(path: Path) -> dict[str, np.ndarray]:
     if not rows:
         return {}
     head, body = rows[0], rows[1:]
-    data = np.array([[float(x) for x in r] for r in body], dtype=float) if body else np.zeros((0, len(head)))
+    data = (
+        np.array([[float(x) for x in r] for r in body], dtype=float)
+        if body
+        else np.zeros((0, len(head)))
+    )
     return {h: data[:, i] for i, h in enumerate(head)}
 
 
@@ -42,7 +46,12 @@ def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
     fig, ax = plt.subplots(figsize=(8, 4))
     ax.semilogy(t, np.maximum(tel["att_err_deg"], ERROR_FLOOR_DEG), label="truth vs target")
     if "fsw_est_err_deg" in tel:
-        ax.semilogy(t, np.maximum(tel["fsw_est_err_deg"], ERROR_FLOOR_DEG), label="FSW estimate vs truth", alpha=0.7)
+        ax.semilogy(
+            t,
+            np.maximum(tel["fsw_est_err_deg"], ERROR_FLOOR_DEG),
+            label="FSW estimate vs truth",
+            alpha=0.7,
+        )
     if band_deg:
         ax.axhline(band_deg, color="k", ls="--", lw=0.8, label=f"settling band {band_deg} deg")
     ax.set_xlabel("time [s]")
@@ -69,13 +78,15 @@ def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
     plt.close(fig)
 
     n_thr = sum(1 for k in tel if k.startswith("thrust_T"))
-    pulses = _read_csv(run_dir / "valve_pulses.csv") if (run_dir / "valve_pulses.csv").exists() else {}
+    pulses = (
+        _read_csv(run_dir / "valve_pulses.csv") if (run_dir / "valve_pulses.csv").exists() else {}
+    )
     fig, ax = plt.subplots(figsize=(8, 0.35 * max(n_thr, 4) + 1.2))
     if pulses and len(pulses.get("t_on_s", [])):
         for k in range(n_thr):
             sel = pulses["thruster"] == k
             on, off = pulses["t_on_s"][sel], pulses["t_off_s"][sel]
-            ax.broken_barh(list(zip(on, off - on)), (k - 0.4, 0.8), color="C0")
+            ax.broken_barh(list(zip(on, off - on, strict=True)), (k - 0.4, 0.8), color="C0")
     ax.set_yticks(range(n_thr))
     ax.set_yticklabels([f"T{k}" for k in range(n_thr)])
     ax.set_xlim(t[0], t[-1])

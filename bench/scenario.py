@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from dbc.schema import Table
 from bench.valves.layouts import LAYOUTS
 from dbc.errors import ConfigError
+from dbc.schema import Table
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -151,8 +151,10 @@ class Scenario:
             ],
             "max_thrust_N": self.valve.max_thrust_N,
             "min_on_s": self.valve.min_on_s,
-            "manoeuvre": {"q_target_BN": list(self.q_target_BN),
-                          "t_start_s": self.manoeuvre_start_s},
+            "manoeuvre": {
+                "q_target_BN": list(self.q_target_BN),
+                "t_start_s": self.manoeuvre_start_s,
+            },
             "flight_sw": self.flight_sw,
         }
 
@@ -175,8 +177,15 @@ def _unit(t: Table, key: str, n: int) -> tuple[float, ...]:
     v = t.vector(key, n)
     norm = math.sqrt(sum(x * x for x in v))
     if abs(norm - 1.0) > UNIT_NORM_TOL:
-        raise t.error(key, list(v), f"a unit vector (norm 1 +- {UNIT_NORM_TOL}), norm is {norm:.6g}")
+        raise t.error(
+            key, list(v), f"a unit vector (norm 1 +- {UNIT_NORM_TOL}), norm is {norm:.6g}"
+        )
     return v
+
+
+def _quat(t: Table, key: str) -> Quat:
+    a, b, c, d = _unit(t, key, 4)
+    return (a, b, c, d)
 
 
 def _mass(t: Table) -> MassSpec:
@@ -189,9 +198,11 @@ def _mass(t: Table) -> MassSpec:
     # positive definite: leading principal minors (Sylvester)
     m1 = J[0][0]
     m2 = J[0][0] * J[1][1] - J[0][1] * J[1][0]
-    m3 = (J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1])
-          - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0])
-          + J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]))
+    m3 = (
+        J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1])
+        - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0])
+        + J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0])
+    )
     if min(m1, m2, m3) <= 0:
         raise t.error("inertia_B_kgm2", [list(r) for r in J], "a positive-definite matrix")
     return MassSpec(m, J)  # type: ignore[arg-type]
@@ -231,7 +242,10 @@ def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec]:
     gyro = GyroSpec(
         arw_rad_sqrt_s=g.number("arw_deg_sqrt_h", lo=0.0) * DEG_RAD / SQRT_HOUR_S,
         bias_rad_s=tuple(x * DEG_RAD / 3600.0 for x in g.vector("bias_deg_h", 3)),  # type: ignore[arg-type]
-        bias_rw_rad_s_sqrt_s=g.number("bias_rw_deg_h_sqrt_h", lo=0.0) * DEG_RAD / 3600.0 / SQRT_HOUR_S,
+        bias_rw_rad_s_sqrt_s=g.number("bias_rw_deg_h_sqrt_h", lo=0.0)
+        * DEG_RAD
+        / 3600.0
+        / SQRT_HOUR_S,
         lsb_rad_s=g.number("lsb_rad_s", lo=0.0),
         range_rad_s=g.number("range_rad_s", lo=0.0, lo_open=True),
     )
@@ -305,15 +319,15 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     bt.done()
 
     it = root.table("initial", {})
-    q0 = _unit(it, "q_BN", 4) if it.has("q_BN") else (1.0, 0.0, 0.0, 0.0)
+    q0 = _quat(it, "q_BN") if it.has("q_BN") else (1.0, 0.0, 0.0, 0.0)
     w0 = tuple(x * DEG_RAD for x in it.vector("omega_BN_B_deg_s", 3, [0.0, 0.0, 0.0]))
-    r0 = it.vector("r_N_m", 3, [0.0, 0.0, 0.0])
-    v0 = it.vector("v_N_m_s", 3, [0.0, 0.0, 0.0])
+    r0 = it.vector3("r_N_m", [0.0, 0.0, 0.0])
+    v0 = it.vector3("v_N_m_s", [0.0, 0.0, 0.0])
     it.done()
 
     mt = root.table("manoeuvre")
     if mt.has("target_q_BN"):
-        q_target = _unit(mt, "target_q_BN", 4)
+        q_target = _quat(mt, "target_q_BN")
     else:
         yaw, pitch, roll = (x * DEG_RAD for x in mt.vector("target_euler_zyx_deg", 3))
         q_target = quat_from_euler_zyx(yaw, pitch, roll)
@@ -332,17 +346,36 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         settling_time_s_max=_opt(et, "settling_time_s_max"),
         steady_state_attitude_error_deg_max=_opt(et, "steady_state_attitude_error_deg_max"),
         steady_state_rate_error_deg_s_max=_opt(et, "steady_state_rate_error_deg_s_max"),
-        steady_state_window_s=et.number("steady_state_window_s", 10.0, lo=0.0, lo_open=True,
-                                        hi=duration_s),
+        steady_state_window_s=et.number(
+            "steady_state_window_s", 10.0, lo=0.0, lo_open=True, hi=duration_s
+        ),
     )
     et.done()
     root.done()
     return Scenario(
-        path=source, name=name, description=description, duration_s=duration_s, seed=seed,
-        actual=actual, nominal=nominal, thrusters=thrusters, valve=valve, gyro=gyro,
-        accel=accel, star_tracker=st, bus=bus, q0_BN=q0, omega0_BN_B_rad_s=w0,  # type: ignore[arg-type]
-        r0_N_m=r0, v0_N_m_s=v0, q_target_BN=q_target, manoeuvre_start_s=t_start,  # type: ignore[arg-type]
-        flight_sw=fsw, faults=faults, expectations=exp, raw=data,
+        path=source,
+        name=name,
+        description=description,
+        duration_s=duration_s,
+        seed=seed,
+        actual=actual,
+        nominal=nominal,
+        thrusters=thrusters,
+        valve=valve,
+        gyro=gyro,
+        accel=accel,
+        star_tracker=st,
+        bus=bus,
+        q0_BN=q0,
+        omega0_BN_B_rad_s=w0,  # type: ignore[arg-type]
+        r0_N_m=r0,
+        v0_N_m_s=v0,
+        q_target_BN=q_target,
+        manoeuvre_start_s=t_start,
+        flight_sw=fsw,
+        faults=faults,
+        expectations=exp,
+        raw=data,
     )
 
 
@@ -352,7 +385,9 @@ def load_scenario(path: str | Path) -> Scenario:
     try:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ConfigError(str(p), "<file>", str(p), f"a readable scenario file ({exc.strerror})") from exc
+        raise ConfigError(
+            str(p), "<file>", str(p), f"a readable scenario file ({exc.strerror})"
+        ) from exc
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -67,6 +67,14 @@ class Encoder:
         self._by_name: dict[str, tuple[Message, int]] = {
             m.name: (m, data_id(m)) for m in db.messages
         }
+        self._limits: dict[str, dict[str, tuple[float, float]]] = {
+            m.name: {
+                s.name: (float(s.minimum), float(s.maximum))
+                for s in m.signals
+                if s.minimum is not None and s.maximum is not None
+            }
+            for m in db.messages
+        }
         self._counters: dict[str, int] = {}
 
     def frame_id(self, name: str) -> int:
@@ -87,13 +95,23 @@ class Encoder:
         self._counters[name] = counter
         values: dict[str, Any] = {"CRC": 0, "AliveCounter": counter}
         values.update(signals)
+        limits = self._limits[name]
+        for sig_name, (lo, hi) in limits.items():
+            v = values.get(sig_name)
+            if v is None or not lo <= v <= hi:
+                raise IcdError(
+                    f"cannot encode {name}: {sig_name} = {v!r} outside "
+                    f"[{lo}, {hi}] (or missing) in {signals}"
+                )
         try:
-            payload = bytearray(message.encode(values, scaling=True, strict=True))
+            payload = bytearray(message.encode(values, scaling=True, strict=False))
         except Exception as exc:  # cantools raises several types; all mean a bad value
             raise IcdError(f"cannot encode {name} from {signals}: {exc}") from exc
         return e2e.protect(did, payload, counter)
 
-    def message(self, name: str, signals: dict[str, float | int], timestamp: float = 0.0) -> can.Message:
+    def message(
+        self, name: str, signals: dict[str, float | int], timestamp: float = 0.0
+    ) -> can.Message:
         """A ``can.Message`` of ``name`` carrying ``signals``."""
         message = self._lookup(name)[0]
         return can.Message(
@@ -182,7 +200,7 @@ class FrameChecker:
             gap = delta - 1
         signals = message.decode(bytes(data), decode_choices=False, scaling=True)
         for sig_name, lo, hi in limits:
-            v = float(signals[sig_name])  # type: ignore[arg-type]
+            v = float(signals[sig_name])  # type: ignore[call-overload, arg-type]
             slack = RANGE_TOLERANCE * max(1.0, abs(lo), abs(hi))
             if v < lo - slack or v > hi + slack:
                 self._count_reject(name, Reject.RANGE)

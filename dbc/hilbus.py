@@ -361,7 +361,7 @@ class HilBus(can.BusABC):
         self._state = BusState.ACTIVE
         self._can_protocol = CanProtocol.CAN_FD
         self._closed = False
-        # tx side (guarded by _tx_lock): connected peers, scan cache, SO_SNDTIMEO cache
+        # tx side (guarded by _tx_lock): connected peers and the directory scan cache
         self._tx_lock = threading.Lock()
         self._peers: dict[str, _Peer] = {}
         self._scan_mtime_ns: int | None = None
@@ -382,11 +382,13 @@ class HilBus(can.BusABC):
         if mtime == self._scan_mtime_ns and not self._scan_unsettled:
             return
         now_ns = time.time_ns()
-        names = {
-            n
-            for n in os.listdir(self.directory)
-            if n != self._name and MEMBER_RE.fullmatch(n) is not None
-        }
+        try:
+            listing = os.listdir(self.directory)
+        except OSError as exc:
+            raise can.CanOperationError(
+                f"hilbus: cannot list channel directory {self.directory}: {exc}"
+            ) from exc
+        names = {n for n in listing if n != self._name and MEMBER_RE.fullmatch(n) is not None}
         for gone in set(self._peers) - names:
             self._peers.pop(gone).sock.close()
         for new in sorted(names - set(self._peers)):
@@ -618,8 +620,13 @@ class HilBus(can.BusABC):
             super().shutdown()
         finally:
             # wake threads blocked in recv() or in a send() waiting for a full member: they
-            # see _closed and raise CanOperationError (and release the tx lock)
-            self._wake_self()
+            # see _closed and raise CanOperationError (and release the tx lock). SHUT_RD
+            # leaves the socket readable for every waiter (a wake-up datagram could be
+            # consumed by one before another saw it); members sending to us get EPIPE.
+            try:
+                self._sock.shutdown(socket.SHUT_RD)
+            except OSError:
+                self._wake_self()
             with contextlib.suppress(OSError):
                 os.unlink(self.path)
             with self._tx_lock:

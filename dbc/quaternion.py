@@ -27,7 +27,7 @@ def pack_quaternion(q: tuple[float, float, float, float] | list[float]) -> dict[
     sign = 1.0 if q[big] >= 0 else -1.0
     rest = [sign * q[i] for i in range(4) if i != big]
     out: dict[str, float | int] = {"Largest": big}
-    for name, c in zip(SIGNALS, rest):
+    for name, c in zip(SIGNALS, rest, strict=True):
         out[name] = min(C_MAX, max(-C_MAX, c))
     return out
 

@@ -1,4 +1,4 @@
-"""Typed, strict reading of TOML tables: every bad value raises ConfigError(file, key, value, expected).
+"""Typed, strict reading of config tables: a bad value raises ConfigError(file, key, value, ...).
 
 Shared by the bench (scenario files) and the flight software (its configuration file), so
 both report bad values the same way. A :class:`Table` wraps one TOML table with its
@@ -49,8 +49,13 @@ class Table:
         return self._data[key]
 
     def number(
-        self, key: str, default: Any = _MISSING, *, lo: float | None = None,
-        hi: float | None = None, lo_open: bool = False,
+        self,
+        key: str,
+        default: Any = _MISSING,
+        *,
+        lo: float | None = None,
+        hi: float | None = None,
+        lo_open: bool = False,
     ) -> float:
         """A finite real number in [lo, hi] (or (lo, hi] with ``lo_open``)."""
         v = self.raw(key, default)
@@ -84,12 +89,25 @@ class Table:
         """A list of ``n`` finite numbers."""
         v = self.raw(key, default)
         if (
-            not isinstance(v, list) or len(v) != n
-            or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                       for x in v)
+            not isinstance(v, list)
+            or len(v) != n
+            or not all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                for x in v
+            )
         ):
             raise self.error(key, v, f"a list of {n} finite numbers")
         return tuple(float(x) for x in v)
+
+    def vector3(self, key: str, default: Any = _MISSING) -> tuple[float, float, float]:
+        """A list of 3 finite numbers."""
+        x, y, z = self.vector(key, 3, default)
+        return (x, y, z)
+
+    def vector4(self, key: str, default: Any = _MISSING) -> tuple[float, float, float, float]:
+        """A list of 4 finite numbers."""
+        a, b, c, d = self.vector(key, 4, default)
+        return (a, b, c, d)
 
     def matrix3(self, key: str) -> tuple[tuple[float, float, float], ...]:
         """A 3x3 list of lists of finite numbers."""
@@ -98,9 +116,13 @@ class Table:
             raise self.error(key, v, "a 3x3 matrix (list of three lists of three numbers)")
         rows = []
         for i, row in enumerate(v):
-            if not isinstance(row, list) or len(row) != 3 or not all(
-                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                for x in row
+            if (
+                not isinstance(row, list)
+                or len(row) != 3
+                or not all(
+                    isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                    for x in row
+                )
             ):
                 raise self.error(f"{key}[{i}]", row, "a list of 3 finite numbers")
             rows.append((float(row[0]), float(row[1]), float(row[2])))

@@ -25,7 +25,9 @@ def main(argv: list[str] | None = None) -> int:
     """Run the flight software."""
     p = argparse.ArgumentParser(prog="thruster-hil-fsw", description=__doc__.split("\n")[0])
     p.add_argument("--config", required=True, help="flight-software configuration JSON")
-    p.add_argument("--bus", help="bus spec (default: socketcan:vcan0 if present, else hilbus:default)")
+    p.add_argument(
+        "--bus", help="bus spec (default: socketcan:vcan0 if present, else hilbus:default)"
+    )
     p.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
     p.add_argument("--stats", help="write frame and cycle statistics JSON here")
     p.add_argument("--check", action="store_true", help="validate the configuration and exit")
@@ -33,7 +35,9 @@ def main(argv: list[str] | None = None) -> int:
     db = load_database()
     try:
         computer = build_computer(
-            load_config(args.config), cycle_time_ns(db, "THR_CMD_0"), cycle_time_ns(db, "IMU_RATE"),
+            load_config(args.config),
+            cycle_time_ns(db, "THR_CMD_0"),
+            cycle_time_ns(db, "IMU_RATE"),
             {"IMU_RATE": cycle_time_ns(db, "IMU_RATE"), "STR_QUAT": cycle_time_ns(db, "STR_QUAT")},
         )
         if args.check:

@@ -1,4 +1,4 @@
-"""The flight software's only wall-clock reader (realtime mode). Models take ``t_ns`` as an argument."""
+"""The flight software's only wall-clock reader. Models take ``t_ns`` as an argument."""
 
 from __future__ import annotations
 

@@ -82,8 +82,9 @@ class FlightComputer:
 
     def on_star_tracker(self, t_ns: int, q_meas_BN: np.ndarray) -> None:
         """One valid star-tracker attitude."""
-        self.estimator.update_star_tracker(self._imu_t_ns if self._imu_t_ns is not None else t_ns,
-                                           q_meas_BN)
+        self.estimator.update_star_tracker(
+            self._imu_t_ns if self._imu_t_ns is not None else t_ns, q_meas_BN
+        )
 
     def cycle(self, t_ns: int) -> CycleResult:
         """Run one control cycle at ``t_ns``; returns the valve on-times for the next period."""
@@ -98,12 +99,14 @@ class FlightComputer:
         if self.safe_latched:
             self.mode = Mode.SAFE
             flags |= FdirFlag.SAFE_LATCHED
-            return CycleResult((0.0,) * n, self.mode, flags, False, 0.0, self.imu_counter,
-                               (0.0, 0.0, 0.0))
+            return CycleResult(
+                (0.0,) * n, self.mode, flags, False, 0.0, self.imu_counter, (0.0, 0.0, 0.0)
+            )
         if not est.initialised:
             self.mode = Mode.BOOT
-            return CycleResult((0.0,) * n, self.mode, flags, False, 0.0, self.imu_counter,
-                               (0.0, 0.0, 0.0))
+            return CycleResult(
+                (0.0,) * n, self.mode, flags, False, 0.0, self.imu_counter, (0.0, 0.0, 0.0)
+            )
         self.mode = Mode.NOMINAL
         if t_ns >= self.timeline.t_start_ns:
             q_ref = self.timeline.q_target_BN
@@ -116,8 +119,14 @@ class FlightComputer:
         period_s = self.control_period_ns / NS_PER_S
         on_times = tuple(
             mod.on_time_s(t_ns, float(thrust) / self.max_thrust_N, period_s)
-            for mod, thrust in zip(self.modulators, alloc.thrust_N)
+            for mod, thrust in zip(self.modulators, alloc.thrust_N, strict=True)
         )
-        return CycleResult(on_times, self.mode, flags, bool(alloc.saturated),
-                           float(alloc.residual_norm), self.imu_counter,
-                           (float(torque[0]), float(torque[1]), float(torque[2])))
+        return CycleResult(
+            on_times,
+            self.mode,
+            flags,
+            bool(alloc.saturated),
+            float(alloc.residual_norm),
+            self.imu_counter,
+            (float(torque[0]), float(torque[1]), float(torque[2])),
+        )

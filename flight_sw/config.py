@@ -59,24 +59,38 @@ class Vehicle:
 
 
 def _mekf(t: Table, v: Vehicle) -> AttitudeEstimator:
-    return Mekf(MekfParams(
-        gyro_arw_rad_sqrt_s=t.number("gyro_arw_deg_sqrt_h", lo=0.0) * DEG_RAD / SQRT_HOUR_S,
-        gyro_bias_rw_rad_s_sqrt_s=t.number("gyro_bias_rw_deg_h_sqrt_h", lo=0.0)
-        * DEG_RAD / 3600.0 / SQRT_HOUR_S,
-        star_tracker_sigma_rad=t.number("star_tracker_noise_arcsec", lo=0.0, lo_open=True) * ARCSEC_RAD,
-        initial_attitude_sigma_rad=t.number("initial_attitude_sigma_deg", 0.1, lo=0.0, lo_open=True)
-        * DEG_RAD,
-        initial_bias_sigma_rad_s=t.number("initial_bias_sigma_deg_h", lo=0.0, lo_open=True)
-        * DEG_RAD / 3600.0,
-    ))
+    return Mekf(
+        MekfParams(
+            gyro_arw_rad_sqrt_s=t.number("gyro_arw_deg_sqrt_h", lo=0.0) * DEG_RAD / SQRT_HOUR_S,
+            gyro_bias_rw_rad_s_sqrt_s=t.number("gyro_bias_rw_deg_h_sqrt_h", lo=0.0)
+            * DEG_RAD
+            / 3600.0
+            / SQRT_HOUR_S,
+            star_tracker_sigma_rad=t.number("star_tracker_noise_arcsec", lo=0.0, lo_open=True)
+            * ARCSEC_RAD,
+            initial_attitude_sigma_rad=t.number(
+                "initial_attitude_sigma_deg", 0.1, lo=0.0, lo_open=True
+            )
+            * DEG_RAD,
+            initial_bias_sigma_rad_s=t.number("initial_bias_sigma_deg_h", lo=0.0, lo_open=True)
+            * DEG_RAD
+            / 3600.0,
+        )
+    )
 
 
 def _quaternion_pd(t: Table, v: Vehicle) -> AttitudeController:
-    max_rate = (t.number("max_rate_deg_s", lo=0.0, lo_open=True) * DEG_RAD
-                if t.has("max_rate_deg_s") else math.inf)
+    max_rate = (
+        t.number("max_rate_deg_s", lo=0.0, lo_open=True) * DEG_RAD
+        if t.has("max_rate_deg_s")
+        else math.inf
+    )
     if t.has("kp_Nm"):
-        params = QuaternionPdParams(kp_Nm=t.vector("kp_Nm", 3), kd_Nms=t.vector("kd_Nms", 3),  # type: ignore[arg-type]
-                                    max_rate_rad_s=max_rate)
+        params = QuaternionPdParams(
+            kp_Nm=t.vector3("kp_Nm"),
+            kd_Nms=t.vector3("kd_Nms"),
+            max_rate_rad_s=max_rate,
+        )
     else:
         params = QuaternionPdParams.from_bandwidth(
             np.diag(v.inertia_B_kgm2).tolist(),
@@ -93,16 +107,20 @@ def _pseudo_inverse(t: Table, v: Vehicle) -> Allocator:
 
 
 def _pwpf(t: Table, v: Vehicle) -> Callable[[], Modulator]:
-    params = PwpfParams(km=t.number("km", lo=0.0, lo_open=True),
-                        tm_s=t.number("tm_s", lo=0.0, lo_open=True),
-                        u_on=t.number("u_on", lo=0.0, lo_open=True),
-                        u_off=t.number("u_off", lo=0.0),
-                        min_on_s=v.min_on_s)
+    params = PwpfParams(
+        km=t.number("km", lo=0.0, lo_open=True),
+        tm_s=t.number("tm_s", lo=0.0, lo_open=True),
+        u_on=t.number("u_on", lo=0.0, lo_open=True),
+        u_off=t.number("u_off", lo=0.0),
+        min_on_s=v.min_on_s,
+    )
     return lambda: PwpfModulator(params)
 
 
 ESTIMATORS: dict[str, Callable[[Table, Vehicle], AttitudeEstimator]] = {"mekf": _mekf}
-CONTROLLERS: dict[str, Callable[[Table, Vehicle], AttitudeController]] = {"quaternion_pd": _quaternion_pd}
+CONTROLLERS: dict[str, Callable[[Table, Vehicle], AttitudeController]] = {
+    "quaternion_pd": _quaternion_pd
+}
 ALLOCATORS: dict[str, Callable[[Table, Vehicle], Allocator]] = {"pseudo_inverse": _pseudo_inverse}
 MODULATORS: dict[str, Callable[[Table, Vehicle], Callable[[], Modulator]]] = {"pwpf": _pwpf}
 
@@ -121,8 +139,12 @@ def _strategy(parent: Table, key: str, registry: dict[str, Any], v: Vehicle) -> 
     return built
 
 
-def build_computer(cfg: dict[str, Any], control_period_ns: int, imu_period_ns: int,
-                   watch_periods_ns: dict[str, int]) -> FlightComputer:
+def build_computer(
+    cfg: dict[str, Any],
+    control_period_ns: int,
+    imu_period_ns: int,
+    watch_periods_ns: dict[str, int],
+) -> FlightComputer:
     """Build the flight computer described by the configuration ``cfg``."""
     source = str(cfg.get("source", "<flight-software config>"))
     root = Table(cfg, source)
@@ -142,10 +164,14 @@ def build_computer(cfg: dict[str, Any], control_period_ns: int, imu_period_ns: i
     fsw.done()
     root.done()
     return FlightComputer(
-        estimator=estimator, controller=controller, allocator=allocator,
+        estimator=estimator,
+        controller=controller,
+        allocator=allocator,
         modulators=[make_modulator() for _ in range(len(vehicle.r_thr_B_m))],
-        max_thrust_N=vehicle.max_thrust_N, control_period_ns=control_period_ns,
-        imu_period_ns=imu_period_ns, timeline=Timeline(q_target, t_start_ns),
+        max_thrust_N=vehicle.max_thrust_N,
+        control_period_ns=control_period_ns,
+        imu_period_ns=imu_period_ns,
+        timeline=Timeline(q_target, t_start_ns),
         watchdog=SensorWatchdog(watch_periods_ns),
     )
 
@@ -156,7 +182,9 @@ def load_config(path: str | Path) -> dict[str, Any]:
     try:
         data = json.loads(p.read_text(encoding="utf-8"))
     except OSError as exc:
-        raise ConfigError(str(p), "<file>", str(p), f"a readable configuration file ({exc.strerror})") from exc
+        raise ConfigError(
+            str(p), "<file>", str(p), f"a readable configuration file ({exc.strerror})"
+        ) from exc
     except json.JSONDecodeError as exc:
         raise ConfigError(str(p), "<syntax>", str(exc), "valid JSON") from exc
     if not isinstance(data, dict):

@@ -26,8 +26,8 @@ import can
 import numpy as np
 from cantools.database.can import Database
 
-from dbc.quaternion import pack_quaternion, unpack_quaternion
 from dbc.codec import Decoded, Encoder, FrameChecker, Reject, cycle_time_ns
+from dbc.quaternion import pack_quaternion, unpack_quaternion
 from flight_sw.clock import MonotonicClock
 from flight_sw.computer import CycleResult, FlightComputer
 
@@ -44,6 +44,20 @@ BENCH_FRAMES = frozenset(
 )
 
 
+def _percentiles_us(samples_ns: list[int]) -> dict[str, float | int | None]:
+    """p50, p99 and max of ``samples_ns`` in microseconds."""
+    if not samples_ns:
+        return {"p50": None, "p99": None, "max": None, "n": 0}
+    a = np.asarray(samples_ns, dtype=float) / 1e3
+    p50, p99 = np.percentile(a, (50.0, 99.0))
+    return {
+        "p50": round(float(p50), 1),
+        "p99": round(float(p99), 1),
+        "max": round(float(a.max()), 1),
+        "n": len(samples_ns),
+    }
+
+
 class StopRequested(Exception):  # noqa: N818 - a request, not an error
     """Raised by the signal handler to leave a blocking receive at once."""
 
@@ -55,19 +69,26 @@ class NodeStats:
     cycles: int = 0
     overruns: int = 0
     sent: dict[str, int] = field(default_factory=dict)
+    cycle_ns: list[int] = field(default_factory=list)  # cycle start -> last frame sent
 
 
 class FlightNode:
     """Binds a FlightComputer to a bus."""
 
-    def __init__(self, db: Database, bus: can.BusABC, computer: FlightComputer,
-                 stats_path: Path | None = None) -> None:
+    def __init__(
+        self,
+        db: Database,
+        bus: can.BusABC,
+        computer: FlightComputer,
+        stats_path: Path | None = None,
+    ) -> None:
         self.db = db
         self.bus = bus
         self.fc = computer
         self.encoder = Encoder(db)
         self.checker = FrameChecker(db, accept=BENCH_FRAMES)
         self.stats = NodeStats()
+        self.clock = MonotonicClock()
         self.stats_path = stats_path
         self.n_thr = len(computer.modulators)
         self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
@@ -84,9 +105,11 @@ class FlightNode:
     # -- signals -----------------------------------------------------------------
     def install_signal_handlers(self) -> None:
         """SIGTERM / SIGINT end the loop at once (even inside a blocking receive)."""
+
         def _handler(signum: int, frame: FrameType | None) -> None:
             self._stop = True
             raise StopRequested(signum)
+
         signal.signal(signal.SIGTERM, _handler)
         signal.signal(signal.SIGINT, _handler)
 
@@ -110,12 +133,17 @@ class FlightNode:
     def send_status(self, cycle: int) -> None:
         """FSW_STATUS and FSW_ATT_EST."""
         fc = self.fc
-        self._send("FSW_STATUS", {
-            "Mode": int(fc.mode), "Cycle": cycle % STATUS_CYCLE_MODULUS,
-            "Overruns": min(self.stats.overruns, OVERRUN_MAX),
-            "FdirFlags": self._last_flags, "AllocSaturated": int(self._last_sat),
-            "AllocResidual": min(self._last_residual, 12.75),
-        })
+        self._send(
+            "FSW_STATUS",
+            {
+                "Mode": int(fc.mode),
+                "Cycle": cycle % STATUS_CYCLE_MODULUS,
+                "Overruns": min(self.stats.overruns, OVERRUN_MAX),
+                "FdirFlags": self._last_flags,
+                "AllocSaturated": int(self._last_sat),
+                "AllocResidual": min(self._last_residual, 12.75),
+            },
+        )
         est = fc.estimator.estimate()
         q = [float(x) for x in est.q_BN]
         self._send("FSW_ATT_EST", {"Valid": int(est.initialised), **pack_quaternion(q)})
@@ -124,17 +152,31 @@ class FlightNode:
         """THR_CMD_0..m for one cycle (thrusters beyond the vehicle's count are 0)."""
         max_on = self.period_ns / 1e9
         for f in range(self.n_cmd_frames):
-            sig: dict[str, float | int] = {"Cycle": cycle % CYCLE_MODULUS, "ImuCounter": res.imu_counter}
+            sig: dict[str, float | int] = {
+                "Cycle": cycle % CYCLE_MODULUS,
+                "ImuCounter": res.imu_counter,
+            }
             for j in range(THRUSTERS_PER_CMD_FRAME):
                 k = f * THRUSTERS_PER_CMD_FRAME + j
                 on = res.on_time_s[k] if k < self.n_thr else 0.0
-                sig[f"OnTime_T{k:02d}"] = round(min(max(on, 0.0), max_on) / ON_TIME_LSB_S) * ON_TIME_LSB_S
+                sig[f"OnTime_T{k:02d}"] = (
+                    round(min(max(on, 0.0), max_on) / ON_TIME_LSB_S) * ON_TIME_LSB_S
+                )
             self._send(f"THR_CMD_{f}", sig)
 
     def run_cycle(self, cycle: int, t_ns: int) -> None:
         """One control cycle at ``t_ns`` and its frames (status first, commands last)."""
+        t0 = self.clock.now_ns()
+        self._cycle_frames(cycle, t_ns)
+        self.stats.cycle_ns.append(self.clock.now_ns() - t0)
+
+    def _cycle_frames(self, cycle: int, t_ns: int) -> None:
         res = self.fc.cycle(t_ns)
-        self._last_flags, self._last_sat, self._last_residual = res.fdir_flags, res.saturated, res.residual_Nm
+        self._last_flags, self._last_sat, self._last_residual = (
+            res.fdir_flags,
+            res.saturated,
+            res.residual_Nm,
+        )
         self.stats.cycles += 1
         if cycle % self.status_every == 0:
             self.send_status(cycle)
@@ -146,7 +188,9 @@ class FlightNode:
         s = d.signals
         if d.name == "IMU_RATE":
             if s["Valid"]:
-                self.fc.on_imu_rate(t_ns, np.array((s["RateX"], s["RateY"], s["RateZ"])), d.counter, d.gap)
+                self.fc.on_imu_rate(
+                    t_ns, np.array((s["RateX"], s["RateY"], s["RateZ"])), d.counter, d.gap
+                )
                 self._pending_seen.add("IMU_RATE")
         elif d.name == "STR_QUAT":
             if s["Valid"]:
@@ -156,8 +200,17 @@ class FlightNode:
             self.fc.thr_status = s
 
     def _heartbeat(self) -> None:
-        self._send("FSW_STATUS", {"Mode": 0, "Cycle": 0, "Overruns": 0, "FdirFlags": 0,
-                                  "AllocSaturated": 0, "AllocResidual": 0.0})
+        self._send(
+            "FSW_STATUS",
+            {
+                "Mode": 0,
+                "Cycle": 0,
+                "Overruns": 0,
+                "FdirFlags": 0,
+                "AllocSaturated": 0,
+                "AllocResidual": 0.0,
+            },
+        )
 
     # -- loops -------------------------------------------------------------------
     def run_lockstep(self) -> None:
@@ -191,9 +244,9 @@ class FlightNode:
             self.run_cycle(cycle, t_ns)
         self.write_stats()
 
-    def run_realtime(self, clock: MonotonicClock | None = None) -> None:
+    def run_realtime(self) -> None:
         """Cycle on this process's own timer until stopped."""
-        clock = clock or MonotonicClock()
+        clock = self.clock
         self._heartbeat()
         period = self.period_ns
         next_ns = clock.now_ns() + period
@@ -233,6 +286,7 @@ class FlightNode:
             "sent": dict(sorted(self.stats.sent.items())),
             "received": self.checker.summary(),
             "mode": self.fc.mode.name,
+            "cycle_time_us": _percentiles_us(self.stats.cycle_ns),
         }
         tmp = self.stats_path.with_suffix(".tmp")
         tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")

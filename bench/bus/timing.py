@@ -40,7 +40,9 @@ def crc15(bits: list[int]) -> int:
     return crc
 
 
-def frame_bitstream(can_id: int, data: bytes, extended: bool = False, remote: bool = False) -> list[int]:
+def frame_bitstream(
+    can_id: int, data: bytes, extended: bool = False, remote: bool = False
+) -> list[int]:
     """The unstuffed bits SOF..CRC of a classic CAN data/remote frame."""
     dlc = len(data)
     bits = [0]  # SOF
@@ -70,10 +72,55 @@ def stuff_count(bits: list[int]) -> int:
     return count
 
 
+def _crc15_table() -> tuple[int, ...]:
+    table = []
+    for byte in range(256):
+        crc = byte << 7
+        for _ in range(8):
+            crc = ((crc << 1) ^ CRC15_POLY) if crc & 0x4000 else (crc << 1)
+            crc &= 0x7FFF
+        table.append(crc)
+    return tuple(table)
+
+
+_CRC15_TABLE = _crc15_table()
+
+
 def frame_bits(can_id: int, data: bytes, extended: bool = False, remote: bool = False) -> int:
-    """Exact length on the wire in bits, including intermission."""
-    stream = frame_bitstream(can_id, data, extended, remote)
-    return len(stream) + stuff_count(stream) + UNSTUFFED_TAIL_BITS
+    """Exact length on the wire in bits, including intermission.
+
+    Same result as ``len(frame_bitstream) + stuff_count(...) + tail``, computed on a bit
+    string with a byte-wise CRC-15 table for speed (the bench calls this per frame).
+    """
+    dlc = len(data)
+    if extended:
+        head = f"0{can_id >> 18:011b}11{can_id & 0x3FFFF:018b}{1 if remote else 0}00{dlc:04b}"
+    else:
+        head = f"0{can_id:011b}{1 if remote else 0}00{dlc:04b}"
+    crc = 0
+    for ch in head:
+        nxt = (ch == "1") ^ ((crc >> 14) & 1)
+        crc = (crc << 1) & 0x7FFF
+        if nxt:
+            crc ^= CRC15_POLY
+    body = "" if remote else data.hex()
+    if body:
+        for byte in data:
+            crc = ((crc << 8) & 0x7FFF) ^ _CRC15_TABLE[((crc >> 7) ^ byte) & 0xFF]
+        bits = head + f"{int(body, 16):0{8 * dlc}b}" + f"{crc:015b}"
+    else:
+        bits = head + f"{crc:015b}"
+    stuff, run, last = 0, 0, ""
+    for ch in bits:
+        if ch == last:
+            run += 1
+            if run == STUFF_RUN:
+                stuff += 1
+                last = "1" if ch == "0" else "0"
+                run = 1
+        else:
+            last, run = ch, 1
+    return len(bits) + stuff + UNSTUFFED_TAIL_BITS
 
 
 def frame_bits_worst_case(dlc: int, extended: bool = False) -> int:

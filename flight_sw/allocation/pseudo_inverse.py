@@ -146,7 +146,7 @@ def _min_fuel_null_rays(b: np.ndarray) -> np.ndarray | None:
     m, n = b.shape
     rays = np.zeros((n, n))
     for i in range(n):
-        bounds = [(0.0, None)] * n
+        bounds: list[tuple[float, float | None]] = [(0.0, None)] * n
         bounds[i] = (1.0, 1.0)
         res = linprog(np.ones(n), A_eq=b, b_eq=np.zeros(m), bounds=bounds)
         if res.status != 0 or res.x is None:

@@ -142,6 +142,7 @@ class QuaternionPd:
         with np.errstate(divide="ignore", invalid="ignore"):
             lim = self._kd * params.max_rate_rad_s / self._kp
         self._q_limit = np.where(np.isfinite(lim), lim, np.inf)
+
     @property
     def params(self) -> QuaternionPdParams:
         """The gains this controller was built with."""
@@ -155,7 +156,7 @@ class QuaternionPd:
         q_RN: np.ndarray,
         omega_RN_B: np.ndarray,
     ) -> np.ndarray:
-        """``τ_B = −K_p ∘ sat_L(sgn(δq0) δq_vec) − K_d ∘ (ω_BN_B − ω_RN_B)`` [N m]; ``t_ns`` unused."""
+        """``τ_B = −K_p ∘ sat_L(sgn(δq0) δq_vec) − K_d ∘ (ω_BN_B − ω_RN_B)`` [N m]."""
         dq = error_quaternion(q_RN, q_BN)
         sign = -1.0 if dq[0] < 0.0 else 1.0
         q_err = np.clip(sign * dq[1:], -self._q_limit, self._q_limit)

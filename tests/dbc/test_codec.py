@@ -52,7 +52,12 @@ def test_bad_frames_are_counted_by_cause(db) -> None:  # type: ignore[no-untyped
     assert chk.check(_frame(bytes(bad_crc))) is None
     assert chk.check(_frame(good, can_id=0x555)) is None
     assert chk.check(can.Message(arbitration_id=0x040, is_error_frame=True)) is None
-    assert chk.check(can.Message(arbitration_id=0x040, is_extended_id=False, is_remote_frame=True, dlc=8)) is None
+    assert (
+        chk.check(
+            can.Message(arbitration_id=0x040, is_extended_id=False, is_remote_frame=True, dlc=8)
+        )
+        is None
+    )
     # FAULT_CMD.FaultType has 6 bits but its DBC range is 0..2: raw 3 is out of range
     fault = enc.encode("FAULT_CMD", {"Action": 1, "FaultType": 1, "Target": 0, "Duration": 0})
     fault[1] |= 0xC0  # FaultType's two low bits (bits 14, 15) -> 3
@@ -60,7 +65,9 @@ def test_bad_frames_are_counted_by_cause(db) -> None:  # type: ignore[no-untyped
     assert chk.check(_frame(bytes(fault), can_id=0x7E0)) is None
     s = chk.summary()
     assert s["IMU_RATE"]["rejected"] == {
-        Reject.COUNTER.value: 1, Reject.DLC.value: 1, Reject.CRC.value: 1,
+        Reject.COUNTER.value: 1,
+        Reject.DLC.value: 1,
+        Reject.CRC.value: 1,
         Reject.REMOTE_FRAME.value: 1,
     }
     assert s["0x555"]["rejected"] == {Reject.UNKNOWN_ID.value: 1}

@@ -18,8 +18,16 @@ SEED = 4
 ON_TIME_RESOLUTION_MAX_S = 1e-4
 MIN_THRUSTERS = 16
 EVENT_MESSAGES = {"FAULT_CMD"}
-PRIORITY_ORDER = ["SYNC", "THR_CMD_0", "IMU_RATE", "STR_QUAT", "THR_STATUS", "FSW_STATUS",
-                  "BENCH_STATUS", "FAULT_CMD"]
+PRIORITY_ORDER = [
+    "SYNC",
+    "THR_CMD_0",
+    "IMU_RATE",
+    "STR_QUAT",
+    "THR_STATUS",
+    "FSW_STATUS",
+    "BENCH_STATUS",
+    "FAULT_CMD",
+]
 
 
 @pytest.fixture(scope="module")
@@ -60,8 +68,13 @@ def test_signals_fit_and_do_not_overlap(db) -> None:  # type: ignore[no-untyped-
 
 def test_valve_commands_cover_16_thrusters_at_0_1_ms(db) -> None:  # type: ignore[no-untyped-def]
     """THR_CMD_0..3 carry on-times for >= 16 thrusters with <= 0.1 ms resolution."""
-    on_times = [s for m in db.messages if m.name.startswith("THR_CMD_")
-                for s in m.signals if s.name.startswith("OnTime_T")]
+    on_times = [
+        s
+        for m in db.messages
+        if m.name.startswith("THR_CMD_")
+        for s in m.signals
+        if s.name.startswith("OnTime_T")
+    ]
     assert len({s.name for s in on_times}) >= MIN_THRUSTERS
     assert all(s.scale <= ON_TIME_RESOLUTION_MAX_S for s in on_times)
 

@@ -36,8 +36,14 @@ class Run:
 def run_cli(args: list[str], out: Path, runtime_dir: Path, timeout_s: float = RUN_TIMEOUT_S) -> Run:
     """Run ``thruster-hil ARGS --out OUT`` with a private hilbus runtime directory."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
-    p = subprocess.run([sys.executable, "-m", "bench.cli", *args, "--out", str(out)],
-                       capture_output=True, text=True, timeout=timeout_s, env=env, cwd=REPO)
+    p = subprocess.run(
+        [sys.executable, "-m", "bench.cli", *args, "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=timeout_s,
+        env=env,
+        cwd=REPO,
+    )
     return Run(p.returncode, p.stdout, p.stderr, out)
 
 

@@ -23,14 +23,25 @@ REALTIME_S = "3"
 
 def _frames(trace: Path) -> list[str]:
     """Trace content without the wall-clock header (date line)."""
-    return [ln for ln in trace.read_text().splitlines() if not ln.startswith(("date", "Begin Triggerblock"))]
+    return [
+        ln
+        for ln in trace.read_text().splitlines()
+        if not ln.startswith(("date", "Begin Triggerblock"))
+    ]
 
 
-def test_same_seed_gives_identical_trace_other_seed_differs(tmp_path: Path, runtime_dir: Path) -> None:
+def test_same_seed_gives_identical_trace_other_seed_differs(
+    tmp_path: Path, runtime_dir: Path
+) -> None:
     """Two lockstep runs with one seed are byte-identical by content; another seed is not."""
-    runs = [run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", SHORT_S,
-                     "--seed", seed], tmp_path / f"r{i}", runtime_dir)
-            for i, seed in enumerate(("11", "11", "12"))]
+    runs = [
+        run_cli(
+            ["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", SHORT_S, "--seed", seed],
+            tmp_path / f"r{i}",
+            runtime_dir,
+        )
+        for i, seed in enumerate(("11", "11", "12"))
+    ]
     traces = [_frames(r.out / "trace.asc") for r in runs]
     assert len(traces[0]) > 1000
     assert traces[0] == traces[1]
@@ -39,12 +50,19 @@ def test_same_seed_gives_identical_trace_other_seed_differs(tmp_path: Path, runt
     assert tel[0] == tel[1]
 
 
-def test_killed_flight_software_closes_valves_and_keeps_run_folder(tmp_path: Path, runtime_dir: Path) -> None:
-    """SIGKILL of the flight software: watchdog closes every valve within 3 periods, folder complete."""
-    cmd = (f"{sys.executable} {REPO / 'tests' / 'e2e' / 'fsw_killed.py'} {KILL_AT_CYCLE} "
-           "--bus {bus} --mode {mode} --config {config} --stats {stats}")
-    r = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", SHORT_S,
-                 "--fsw-cmd", cmd], tmp_path / "run", runtime_dir)
+def test_killed_flight_software_closes_valves_and_keeps_run_folder(
+    tmp_path: Path, runtime_dir: Path
+) -> None:
+    """SIGKILL of the flight software: valves closed within 3 periods, run folder complete."""
+    cmd = (
+        f"{sys.executable} {REPO / 'tests' / 'e2e' / 'fsw_killed.py'} {KILL_AT_CYCLE} "
+        "--bus {bus} --mode {mode} --config {config} --stats {stats}"
+    )
+    r = run_cli(
+        ["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", SHORT_S, "--fsw-cmd", cmd],
+        tmp_path / "run",
+        runtime_dir,
+    )
     s = r.summary
     assert s["valve_watchdog_trips"] == 1
     events = (r.out / "events.jsonl").read_text().splitlines()
@@ -73,8 +91,20 @@ def test_bad_scenario_names_file_key_and_value(tmp_path: Path, runtime_dir: Path
 
 def test_realtime_run_measures_latency(tmp_path: Path, runtime_dir: Path) -> None:
     """A short realtime run reports measured sensor-to-command latency and deadline counters."""
-    r = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--mode", "realtime",
-                 "--duration", REALTIME_S], tmp_path / "run", runtime_dir)
+    r = run_cli(
+        [
+            "run",
+            str(QUICKSTART),
+            "--bus",
+            unique_bus(),
+            "--mode",
+            "realtime",
+            "--duration",
+            REALTIME_S,
+        ],
+        tmp_path / "run",
+        runtime_dir,
+    )
     s = r.summary
     lat = s["latency_us"]["sensor_to_command"]
     assert s["mode"] == "realtime"

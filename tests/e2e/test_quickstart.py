@@ -15,12 +15,37 @@ pytestmark = pytest.mark.slow
 
 SETTLING_MAX_S = 10.0
 STEADY_STATE_MAX_DEG = 0.1
-RUN_FILES = ("summary.json", "trace.asc", "telemetry.csv", "valve_pulses.csv", "events.jsonl",
-             "attitude_error.png", "rates.png", "thruster_raster.png", "fsw_config.json")
-SUMMARY_KEYS = ("scenario", "mode", "seed", "bus", "sim_time_s", "wall_time_s", "realtime_factor",
-                "converged", "settling_time_s", "steady_state_attitude_error_deg",
-                "steady_state_rate_error_deg_s", "propellant_kg", "valve_openings", "frames",
-                "latency_us", "deadline_misses", "faults", "expectations")
+RUN_FILES = (
+    "summary.json",
+    "trace.asc",
+    "telemetry.csv",
+    "valve_pulses.csv",
+    "events.jsonl",
+    "attitude_error.png",
+    "rates.png",
+    "thruster_raster.png",
+    "fsw_config.json",
+)
+SUMMARY_KEYS = (
+    "scenario",
+    "mode",
+    "seed",
+    "bus",
+    "sim_time_s",
+    "wall_time_s",
+    "realtime_factor",
+    "converged",
+    "settling_time_s",
+    "steady_state_attitude_error_deg",
+    "steady_state_rate_error_deg_s",
+    "propellant_kg",
+    "valve_openings",
+    "frames",
+    "latency_us",
+    "deadline_misses",
+    "faults",
+    "expectations",
+)
 
 
 @pytest.fixture(scope="module")
@@ -28,8 +53,9 @@ def quickstart(tmp_path_factory: pytest.TempPathFactory) -> Run:
     """One full lockstep quickstart run."""
     xdg = tmp_path_factory.mktemp("xdg")
     xdg.chmod(0o700)
-    return run_cli(["run", str(QUICKSTART), "--bus", unique_bus()],
-                   tmp_path_factory.mktemp("qs") / "run", xdg)
+    return run_cli(
+        ["run", str(QUICKSTART), "--bus", unique_bus()], tmp_path_factory.mktemp("qs") / "run", xdg
+    )
 
 
 def test_quickstart_meets_its_expectations(quickstart: Run) -> None:
@@ -82,4 +108,5 @@ def test_trace_decodes_and_counters_advance_without_gaps(quickstart: Run) -> Non
         assert msg.timestamp >= t_prev
         t_prev = msg.timestamp
     assert sum(per_id.values()) == sum(
-        f["sent"] for f in quickstart.summary["frames"].values() if f["sent"])
+        f["sent"] for f in quickstart.summary["frames"].values() if f["sent"]
+    )

@@ -79,7 +79,7 @@ def test_known_counterexample_needs_the_repair(
 def test_plain_shift_is_exact_below_overflow_bound(
     layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
 ) -> None:
-    """Without repair, demands below the layout's overflow bound are reproduced by B⁺ d + shifts alone."""
+    """Without repair, demands under the overflow bound are reproduced by B⁺ d + shifts."""
     b = matrix(layout, rows)
     plain = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n, exact_repair=False))
     tcap = max_thrust_n / SEED003_SHIFT_OVERFLOW_BOUND[rows]
