@@ -4,15 +4,16 @@ For each bus (``hilbus``, python-can ``virtual`` as the in-process baseline, and
 ``socketcan:vcan0`` when the kernel has it):
 
 * round trip: this process sends a frame, an echo peer sends it back, N times (default
-  5000) after a warm-up; p50 (the run's median), p99, max and mean in µs. The peer is a
-  second OS process, except for ``virtual`` (python-can's virtual bus cannot cross
-  processes), where it is a thread of this process.
+  5000) per run, R runs (default 3) after a warm-up; p50 (the run's median), p99, max and
+  mean in µs of the run with the median p50 (the host is shared and noisy: the 1-minute
+  load average is reported too). The peer is a second OS process, except for ``virtual``
+  (python-can's virtual bus cannot cross processes), where it is a thread of this process.
 * throughput: this process sends M frames (default 100 000) back to back; the peer counts
   them (checking their sequence numbers) and reports when it has seen the last one.
   Frames/s over that span, plus frames lost or out of order.
 
-Usage: ``python benchmarks/bus_roundtrip.py [--rtt-n 5000] [--throughput-n 100000]``
-(runs in well under 30 s with the defaults).
+Usage: ``python benchmarks/bus_roundtrip.py [--rtt-n 5000] [--rtt-runs 3]
+[--throughput-n 100000]`` (about 7 s here with the defaults, well under 30 s).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ import sys
 import threading
 import time
 import uuid
+from dataclasses import dataclass
 from pathlib import Path
 
 import can
@@ -45,11 +47,21 @@ SEQ = struct.Struct("<I")
 REPORT = struct.Struct("<II")
 
 RTT_N_DEFAULT = 5000
+RTT_RUNS_DEFAULT = 3
 THROUGHPUT_N_DEFAULT = 100_000
 WARMUP_S = 1.5  # > dbc.hilbus.MTIME_SETTLE_S: membership caches have settled
 STARTUP_TIMEOUT_S = 20.0
 REPLY_TIMEOUT_S = 10.0
 SYS_NET = Path("/sys/class/net")
+
+
+@dataclass(frozen=True)
+class Config:
+    """What to measure."""
+
+    rtt_n: int
+    rtt_runs: int
+    throughput_n: int
 
 
 def echo(spec: str) -> None:
@@ -106,21 +118,35 @@ def _ping(bus: can.BusABC, seq: int) -> float:
     return time.perf_counter() - t0
 
 
-def measure(bus: can.BusABC, rtt_n: int, throughput_n: int) -> dict[str, object]:
+def _rtt_stats(rtts_us: list[float]) -> dict[str, float]:
+    rtts_us = sorted(rtts_us)
+    n = len(rtts_us)
+    return {
+        "p50": round(statistics.median(rtts_us), 1),
+        "p99": round(rtts_us[min(n - 1, int(0.99 * n))], 1),
+        "max": round(rtts_us[-1], 1),
+        "mean": round(statistics.fmean(rtts_us), 1),
+    }
+
+
+def measure(bus: can.BusABC, cfg: Config) -> dict[str, object]:
     """Warm up, then round trips and throughput against a peer that is already READY."""
     seq = 0
     warm_until = time.monotonic() + WARMUP_S
     while time.monotonic() < warm_until:
         _ping(bus, seq)
         seq += 1
-    rtts_us = []
-    for _ in range(rtt_n):
-        rtts_us.append(_ping(bus, seq) * 1e6)
-        seq += 1
-    rtts_us.sort()
+    runs = []
+    for _ in range(cfg.rtt_runs):
+        rtts_us = []
+        for _ in range(cfg.rtt_n):
+            rtts_us.append(_ping(bus, seq) * 1e6)
+            seq += 1
+        runs.append(_rtt_stats(rtts_us))
+    median_run = sorted(runs, key=lambda r: r["p50"])[len(runs) // 2]
 
     t0 = time.perf_counter()
-    for i in range(throughput_n):
+    for i in range(cfg.throughput_n):
         bus.send(
             can.Message(arbitration_id=SINK_ID, is_extended_id=False, data=SEQ.pack(i) + b"\0" * 4)
         )
@@ -130,22 +156,21 @@ def measure(bus: can.BusABC, rtt_n: int, throughput_n: int) -> dict[str, object]
     count, out_of_order = REPORT.unpack_from(reply.data)
     return {
         "rtt_us": {
-            "n": rtt_n,
-            "p50": round(statistics.median(rtts_us), 1),
-            "p99": round(rtts_us[min(rtt_n - 1, int(0.99 * rtt_n))], 1),
-            "max": round(rtts_us[-1], 1),
-            "mean": round(statistics.fmean(rtts_us), 1),
+            "n": cfg.rtt_n,
+            "runs": cfg.rtt_runs,
+            **median_run,
+            "p50_of_each_run": [r["p50"] for r in runs],
         },
         "throughput": {
-            "frames": throughput_n,
-            "frames_per_s": round(throughput_n / elapsed_s),
-            "lost": throughput_n - count,
+            "frames": cfg.throughput_n,
+            "frames_per_s": round(cfg.throughput_n / elapsed_s),
+            "lost": cfg.throughput_n - count,
             "out_of_order": out_of_order,
         },
     }
 
 
-def run_process_peer(spec: str, rtt_n: int, throughput_n: int) -> dict[str, object]:
+def run_process_peer(spec: str, cfg: Config) -> dict[str, object]:
     """Measure against an echo peer in a second OS process."""
     with open_bus(spec) as bus:
         peer = subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "--echo", spec])
@@ -159,7 +184,7 @@ def run_process_peer(spec: str, rtt_n: int, throughput_n: int) -> dict[str, obje
                     raise RuntimeError(f"echo process for {spec} exited {peer.returncode}")
                 if time.monotonic() > deadline:
                     raise TimeoutError(f"echo process for {spec} not ready")
-            result = measure(bus, rtt_n, throughput_n)
+            result = measure(bus, cfg)
             bus.send(can.Message(arbitration_id=STOP_ID, is_extended_id=False))
             peer.wait(timeout=REPLY_TIMEOUT_S)
         finally:
@@ -169,13 +194,13 @@ def run_process_peer(spec: str, rtt_n: int, throughput_n: int) -> dict[str, obje
     return {"peer": "second OS process", **result}
 
 
-def run_thread_peer(spec: str, rtt_n: int, throughput_n: int) -> dict[str, object]:
+def run_thread_peer(spec: str, cfg: Config) -> dict[str, object]:
     """Measure against an echo peer in a thread of this process."""
     with open_bus(spec) as bus:
         peer = threading.Thread(target=echo, args=(spec,), daemon=True)
         peer.start()
         _wait_for(bus, READY_ID)
-        result = measure(bus, rtt_n, throughput_n)
+        result = measure(bus, cfg)
         bus.send(can.Message(arbitration_id=STOP_ID, is_extended_id=False))
         peer.join(timeout=REPLY_TIMEOUT_S)
     return {"peer": "thread of the same process", **result}
@@ -184,7 +209,10 @@ def run_thread_peer(spec: str, rtt_n: int, throughput_n: int) -> dict[str, objec
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run every bus available here and print the JSON figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rtt-n", type=int, default=RTT_N_DEFAULT, help="round trips")
+    parser.add_argument("--rtt-n", type=int, default=RTT_N_DEFAULT, help="round trips per run")
+    parser.add_argument(
+        "--rtt-runs", type=int, default=RTT_RUNS_DEFAULT, help="runs (the median run is shown)"
+    )
     parser.add_argument(
         "--throughput-n", type=int, default=THROUGHPUT_N_DEFAULT, help="frames one way"
     )
@@ -193,22 +221,23 @@ def main(argv: list[str] | None = None) -> None:
     if args.echo:
         echo(args.echo)
         return
+    cfg = Config(args.rtt_n, args.rtt_runs, args.throughput_n)
 
+    load_before = os.getloadavg()[0]
     tag = f"bench-{os.getpid()}-{uuid.uuid4().hex[:6]}"
     results: dict[str, object] = {}
     started = time.perf_counter()
-    results[f"hilbus:{tag}"] = run_process_peer(f"hilbus:{tag}", args.rtt_n, args.throughput_n)
-    results[f"virtual:{tag}"] = run_thread_peer(f"virtual:{tag}", args.rtt_n, args.throughput_n)
+    results[f"hilbus:{tag}"] = run_process_peer(f"hilbus:{tag}", cfg)
+    results[f"virtual:{tag}"] = run_thread_peer(f"virtual:{tag}", cfg)
     if (SYS_NET / "vcan0").exists():
-        results["socketcan:vcan0"] = run_process_peer(
-            "socketcan:vcan0", args.rtt_n, args.throughput_n
-        )
+        results["socketcan:vcan0"] = run_process_peer("socketcan:vcan0", cfg)
     report = {
         "benchmark": "bus_roundtrip",
         "python": platform.python_version(),
         "python_can": can.__version__,
         "platform": platform.platform(),
         "cpus": os.cpu_count(),
+        "load_avg_1min_before": round(load_before, 2),
         "results": results,
         "wall_s": round(time.perf_counter() - started, 1),
     }
