@@ -8,6 +8,8 @@ For each bus (``hilbus``, python-can ``virtual`` as the in-process baseline, and
   mean in µs of the run with the median p50 (the host is shared and noisy: the 1-minute
   load average is reported too). The peer is a second OS process, except for ``virtual``
   (python-can's virtual bus cannot cross processes), where it is a thread of this process.
+  For scale, the round trip of bare datagrams between two Python processes over a Unix
+  socketpair is measured first (the host's floor at that moment).
 * throughput: this process sends M frames (default 100 000) back to back; the peer counts
   them (checking their sequence numbers) and reports when it has seen the last one.
   Frames/s over that span, plus frames lost or out of order.
@@ -22,10 +24,12 @@ import argparse
 import json
 import os
 import platform
+import socket
 import statistics
 import struct
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import uuid
@@ -53,6 +57,7 @@ WARMUP_S = 1.5  # > dbc.hilbus.MTIME_SETTLE_S: membership caches have settled
 STARTUP_TIMEOUT_S = 20.0
 REPLY_TIMEOUT_S = 10.0
 SYS_NET = Path("/sys/class/net")
+RAW_RECORD_B = 23  # a hilbus record of a 8-byte frame
 
 
 @dataclass(frozen=True)
@@ -206,6 +211,32 @@ def run_thread_peer(spec: str, cfg: Config) -> dict[str, object]:
     return {"peer": "thread of the same process", **result}
 
 
+def raw_unix_rtt_us(n: int) -> float:
+    """p50 round trip of bare datagrams over a socketpair to a forked child: the host's floor.
+
+    Wake-up latency on a shared VM varies several-fold over minutes; this puts the bus
+    figures beside what the kernel and Python alone achieve at the same moment.
+    """
+    mine, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_DGRAM)
+    with mine, theirs:
+        pid = os.fork()
+        if pid == 0:  # child: echo until an empty datagram
+            mine.close()
+            while d := theirs.recv(RAW_RECORD_B):
+                theirs.send(d)
+            os._exit(0)
+        rtts_us = []
+        record = bytes(RAW_RECORD_B)
+        for _ in range(n):
+            t0 = time.perf_counter()
+            mine.send(record)
+            mine.recv(RAW_RECORD_B)
+            rtts_us.append((time.perf_counter() - t0) * 1e6)
+        mine.send(b"")
+        os.waitpid(pid, 0)
+    return round(statistics.median(rtts_us), 1)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point: run every bus available here and print the JSON figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -224,10 +255,14 @@ def main(argv: list[str] | None = None) -> None:
     cfg = Config(args.rtt_n, args.rtt_runs, args.throughput_n)
 
     load_before = os.getloadavg()[0]
+    raw_before = raw_unix_rtt_us(cfg.rtt_n)  # before any thread exists (fork)
     tag = f"bench-{os.getpid()}-{uuid.uuid4().hex[:6]}"
     results: dict[str, object] = {}
     started = time.perf_counter()
-    results[f"hilbus:{tag}"] = run_process_peer(f"hilbus:{tag}", cfg)
+    with tempfile.TemporaryDirectory(prefix="thb-bench-") as runtime:
+        # a private hilbus runtime dir (inherited by the echo process): nothing left behind
+        os.environ["XDG_RUNTIME_DIR"] = runtime
+        results[f"hilbus:{tag}"] = run_process_peer(f"hilbus:{tag}", cfg)
     results[f"virtual:{tag}"] = run_thread_peer(f"virtual:{tag}", cfg)
     if (SYS_NET / "vcan0").exists():
         results["socketcan:vcan0"] = run_process_peer("socketcan:vcan0", cfg)
@@ -238,6 +273,7 @@ def main(argv: list[str] | None = None) -> None:
         "platform": platform.platform(),
         "cpus": os.cpu_count(),
         "load_avg_1min_before": round(load_before, 2),
+        "raw_unix_socketpair_rtt_p50_us_before": raw_before,
         "results": results,
         "wall_s": round(time.perf_counter() - started, 1),
     }

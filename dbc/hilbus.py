@@ -10,9 +10,10 @@ connect to), was measured here at ~156 µs round trip and ~24k frames/s, and nee
 process that must be started first and may die; a Unix-datagram relay process measured
 ~42 µs and 62k frames/s. hilbus has no server or relay at all: every member writes straight
 into every other member's socket, one kernel hop. ``benchmarks/bus_roundtrip.py`` measured
-(2 vCPUs, Python 3.11, echo in a second process): round trip p50 25-30 µs on a quiet host
-(70-95 µs while other runs loaded it; python-can's in-process ``virtual`` bus is no faster),
-and 50k-140k frames/s one way with none lost.
+(2 vCPUs, Python 3.11, echo in a second process): round trip p50 25-41 µs (~95 µs at
+moments when even bare Python datagrams over a socketpair took 80 µs: the VM's wake-up
+latency varies), the same as python-can's in-process ``virtual`` bus with an echo thread;
+48k-165k frames/s one way, none lost.
 
 It is registered as a python-can interface (entry point ``can.interface``:
 ``hilbus = "dbc.hilbus:HilBus"``), so any python-can program or stock tool attaches::
