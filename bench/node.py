@@ -209,7 +209,7 @@ class BenchNode:
         fq = self.fsw_q_est if (self.fsw_q_est and self.fsw_q_valid) else None
         est_err = self.fsw_est_err_deg if fq else float("nan")
         thr = self.plant.thrusters
-        row: list[float | int | str] = [t_ns / NS_PER_S, *q, *s[4:13], err, rate_err]
+        row: list[float | int] = [t_ns / NS_PER_S, *q, *s[4:13], err, rate_err]
         row += list(fq) if fq else [float("nan")] * 4
         row += [est_err, int(self.fsw_status.get("Mode", -1))]
         row += [thr.valves[k].thrust_N(t_ns) for k in range(self.n_thr)]
@@ -442,6 +442,10 @@ class BenchNode:
 
     def _collect_lockstep(self, k: int, ready_ns: int) -> None:
         """Receive this cycle's commands, deliver them at their modelled arrival."""
+        # While the flight software computes: integrate the steps that end before its
+        # frames can arrive, and record the bench's own frames already on the wire.
+        self.integrate_to(max(self.plant.t_ns, ready_ns // STEP_NS * STEP_NS))
+        self._flush_wire(ready_ns)
         want = self.n_cmd_frames
         got: list[tuple[int, int, dict[str, float]]] = []  # (frame index, seq, signals)
         fsw_dead = self.fsw_alive is not None and not self.fsw_alive()

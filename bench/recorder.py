@@ -21,6 +21,7 @@ from typing import IO, Any
 import can
 
 NS_PER_S = 1e9
+NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at 1e4 s
 
 
 class TraceRecorder:
@@ -69,13 +70,13 @@ class TelemetryWriter:
     def __init__(self, path: Path, columns: list[str]) -> None:
         self.path = path
         self._file: IO[str] = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
-        self._csv = csv.writer(self._file)
-        self._csv.writerow(columns)
+        csv.writer(self._file).writerow(columns)
         self.columns = columns
+        self._fmt = ",".join([NUMBER_FORMAT] * len(columns)) + "\n"
 
-    def row(self, values: list[float | int | str]) -> None:
-        """Append one row (same order as the columns)."""
-        self._csv.writerow(values)
+    def row(self, values: list[float | int]) -> None:
+        """Append one row of numbers (same order as the columns), 10 significant digits."""
+        self._file.write(self._fmt % tuple(values))
 
     def flush(self) -> None:
         """Flush to disk."""

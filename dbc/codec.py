@@ -59,6 +59,26 @@ def cycle_time_ns(db: Database, name: str) -> int:
     return int(ms) * 1_000_000
 
 
+def _range_checks(m: Message) -> list[tuple[str, float, float]]:
+    """(signal, min - slack, max + slack) for the signals whose raw range can leave the DBC range.
+
+    A signal whose every raw value maps inside [minimum, maximum] (e.g. a 1-bit flag with
+    range 0..1) needs no check on receipt, which keeps wide status frames cheap.
+    """
+    out = []
+    for s in m.signals:
+        if s.minimum is None or s.maximum is None:
+            continue
+        lo, hi = float(s.minimum), float(s.maximum)
+        raw_lo = -(1 << (s.length - 1)) if s.is_signed else 0
+        raw_hi = (1 << (s.length - 1)) - 1 if s.is_signed else (1 << s.length) - 1
+        phys = sorted((raw_lo * s.scale + s.offset, raw_hi * s.scale + s.offset))
+        slack = RANGE_TOLERANCE * max(1.0, abs(lo), abs(hi))
+        if phys[0] < lo - slack or phys[1] > hi + slack:
+            out.append((s.name, lo - slack, hi + slack))
+    return out
+
+
 class Encoder:
     """Encodes messages of one sender, keeping one alive counter per message."""
 
@@ -149,12 +169,7 @@ class FrameChecker:
         """``accept``: names this receiver consumes; other known frames are ignored, not counted."""
         self._by_id: dict[int, tuple[Message, int, list[tuple[str, float, float]]]] = {}
         for m in db.messages:
-            limits = [
-                (s.name, float(s.minimum), float(s.maximum))
-                for s in m.signals
-                if s.minimum is not None and s.maximum is not None
-            ]
-            self._by_id[m.frame_id] = (m, data_id(m), limits)
+            self._by_id[m.frame_id] = (m, data_id(m), _range_checks(m))
         self._accept = accept
         self._last_counter: dict[int, int] = {}
         self.stats: dict[str, FrameStats] = defaultdict(FrameStats)
@@ -200,9 +215,8 @@ class FrameChecker:
             gap = delta - 1
         signals = message.decode(bytes(data), decode_choices=False, scaling=True)
         for sig_name, lo, hi in limits:
-            v = float(signals[sig_name])  # type: ignore[call-overload, arg-type]
-            slack = RANGE_TOLERANCE * max(1.0, abs(lo), abs(hi))
-            if v < lo - slack or v > hi + slack:
+            v = signals[sig_name]  # type: ignore[call-overload]
+            if v < lo or v > hi:  # type: ignore[operator]
                 self._count_reject(name, Reject.RANGE)
                 self._last_counter[msg.arbitration_id] = counter
                 return None

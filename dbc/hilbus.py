@@ -127,6 +127,9 @@ SOCKET_BUFFER_B = 4 * 1024 * 1024
 #: a directory changed less than this long ago may change again with the same mtime
 #: (coarse file-system clocks: a jiffy on Linux, 1 s on old file systems): rescan.
 MTIME_SETTLE_S = 1.1
+# While unsettled, rescan on send at most this often, unless a frame arrived since the last
+# scan (its sender may be a member not seen yet; it bound its socket before sending).
+UNSETTLED_RESCAN_NS = 1_000_000
 #: wait between retries where the OS cannot tell when a full receiver has room (macOS).
 FULL_RETRY_S = 0.001
 #: consecutive "peer writable, send still would block" before falling back to retries.
@@ -373,6 +376,8 @@ class HilBus(can.BusABC):
         self._peers: dict[str, _Peer] = {}
         self._scan_mtime_ns: int | None = None
         self._scan_unsettled = True
+        self._scan_mono_ns = 0
+        self._rx_since_scan = False
         # rx side (guarded by _rx_lock): records drained from the socket while a send was
         # blocked, or own frames that found the socket full, as (rx time, record)
         self._rx_lock = threading.Lock()
@@ -386,8 +391,15 @@ class HilBus(can.BusABC):
     def _refresh_peers(self) -> None:
         """Rescan the channel directory if it changed (or may have) since the last scan."""
         mtime = os.fstat(self._dir_fd).st_mtime_ns
-        if mtime == self._scan_mtime_ns and not self._scan_unsettled:
-            return
+        if mtime == self._scan_mtime_ns:
+            if not self._scan_unsettled:
+                return
+            # unsettled: rescan after a receive (its sender may be new) or every 1 ms
+            mono_ns = time.monotonic_ns()
+            if not self._rx_since_scan and mono_ns - self._scan_mono_ns < UNSETTLED_RESCAN_NS:
+                return
+        self._rx_since_scan = False
+        self._scan_mono_ns = time.monotonic_ns()
         now_ns = time.time_ns()
         try:
             listing = os.listdir(self.directory)
@@ -570,6 +582,7 @@ class HilBus(can.BusABC):
                 continue
             if not record:
                 continue  # a wake-up datagram
+            self._rx_since_scan = True
             msg = self._decode(record, rx_time)
             if msg is None:
                 self.malformed_records += 1
