@@ -82,13 +82,17 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         duration_s=args.duration if args.duration is not None else sc.duration_s,
         fsw_cmd=None if alone else (args.fsw_cmd or DEFAULT_FSW_CMD),
     )
-    if alone:
+
+    def ready(config: Path) -> None:
         print(
-            f"bench waiting for flight software on {bus} (FSW_STATUS heartbeat), "
-            f"mode {opts.mode}, up to {sc.bus.startup_timeout_s} s",
+            f"bench ready on {bus}, mode {opts.mode}: waiting up to "
+            f"{sc.bus.startup_timeout_s} s for flight software (FSW_STATUS heartbeat); "
+            f"its configuration: {config}",
             file=sys.stderr,
+            flush=True,
         )
-    summary = run_scenario(sc, opts, _progress_printer())
+
+    summary = run_scenario(sc, opts, _progress_printer(), ready if alone else None)
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     _print_summary(summary, opts.out)

@@ -77,7 +77,10 @@ def _stop(proc: subprocess.Popen[bytes]) -> int | None:
 
 
 def run_scenario(
-    sc: Scenario, opts: RunOptions, progress: Callable[[float, float], None] | None = None
+    sc: Scenario,
+    opts: RunOptions,
+    progress: Callable[[float, float], None] | None = None,
+    ready: Callable[[Path], None] | None = None,
 ) -> dict[str, Any]:
     """Run ``sc``; returns the summary (also written to ``opts.out/summary.json``)."""
     out = opts.out
@@ -90,6 +93,8 @@ def run_scenario(
     bus = open_bus(opts.bus)
     proc: subprocess.Popen[bytes] | None = None
     node = BenchNode(sc, db, bus, out, opts.mode, opts.seed, opts.bus, progress)
+    if ready is not None:
+        ready(config)
     error: BaseException | None = None
     try:
         if opts.fsw_cmd is not None:

@@ -49,9 +49,9 @@ class TraceRecorder:
         self._writer.on_message_received(rec)
         self.frames_written += 1
 
-    def event(self, t_ns: int, kind: str, **fields: Any) -> None:
-        """Append one event line and flush it."""
-        self._events.write(json.dumps({"t_s": t_ns / NS_PER_S, "event": kind, **fields}) + "\n")
+    def event(self, t_ns: int, what: str, /, **fields: Any) -> None:
+        """Append one event line (``what`` at ``t_ns`` with ``fields``) and flush it."""
+        self._events.write(json.dumps({"t_s": t_ns / NS_PER_S, "event": what, **fields}) + "\n")
         self._events.flush()
 
     def flush(self) -> None:
