@@ -171,6 +171,7 @@ class BenchNode:
         self.wall_s = 0.0
         self.fsw_alive: Callable[[], bool] | None = None
         self._wire_pending: dict[int, tuple[can.Message, bool]] = {}
+        self.last_sync_ns = 0  # lockstep: time of the run's last SYNC
 
     # -- telemetry ---------------------------------------------------------------
     def _columns(self) -> list[str]:
@@ -331,7 +332,10 @@ class BenchNode:
                 self._telemetry_row(t)
             self._queue_due(t)
             if self.queue and self.mode == "lockstep":
-                self._send_queue()
+                if t <= self.last_sync_ns:
+                    self._send_queue()
+                else:  # sampled after the last SYNC of the run: that cycle never comes
+                    self.queue.clear()
 
     # -- transmit / receive --------------------------------------------------------
     def _send(
@@ -417,6 +421,7 @@ class BenchNode:
     def run_lockstep(self, duration_s: float) -> None:
         """Lockstep run of ``duration_s`` simulated seconds."""
         n_cycles = round(duration_s * NS_PER_S / self.period_ns)
+        self.last_sync_ns = (n_cycles - 1) * self.period_ns
         delay_ns = round(self.sc.bus.fsw_response_delay_s * NS_PER_S)
         self.wait_for_fsw()
         self.trace.event(0, "run_started", mode=self.mode, seed=self.seed, cycles=n_cycles)
