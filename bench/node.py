@@ -33,7 +33,7 @@ from cantools.database.can import Database
 from bench.bus.timing import BusArbiter, frame_bits
 from bench.metrics import expectation, latency_summary, pointing_metrics
 from bench.plant import STEP_NS, Plant
-from bench.recorder import TelemetryWriter, TraceRecorder
+from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder
 from bench.scenario import Scenario
 from dbc.codec import Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.errors import RunError
@@ -108,10 +108,15 @@ class Clock:
     """The bench's wall clock (the only reader of wall time in the bench)."""
 
     t0_ns: int = field(default_factory=time.monotonic_ns)
+    wall0_s: float = field(default_factory=time.time)
 
     def now_ns(self) -> int:
         """Nanoseconds since the clock was made."""
         return time.monotonic_ns() - self.t0_ns
+
+    def from_wall_ns(self, wall_s: float) -> int:
+        """A wall-clock timestamp (``time.time()`` seconds, e.g. a frame's) on this clock."""
+        return round((wall_s - self.wall0_s) * NS_PER_S)
 
 
 class BenchNode:
@@ -142,6 +147,9 @@ class BenchNode:
         self.arbiter = BusArbiter(sc.bus.bitrate_bps)
         self.trace = TraceRecorder(run_dir)
         self.telemetry = TelemetryWriter(run_dir / "telemetry.csv", self._columns())
+        self.chains = TelemetryWriter(run_dir / "chains.csv", CHAIN_COLUMNS)
+        self.open_delay_ns = round(sc.valve.open_delay_s * NS_PER_S)
+        self._rt_fire_ns: int | None = None
         self.pulses = TelemetryWriter(
             run_dir / "valve_pulses.csv", ["t_on_s", "t_off_s", "thruster"]
         )
@@ -170,7 +178,7 @@ class BenchNode:
         self.tel_rate_err: list[float] = []
         self.wall_s = 0.0
         self.fsw_alive: Callable[[], bool] | None = None
-        self._wire_pending: dict[int, tuple[can.Message, bool]] = {}
+        self._wire_pending: dict[int, tuple[can.Message, bool, int]] = {}
         self.last_sync_ns = 0  # lockstep: time of the run's last SYNC
 
     # -- telemetry ---------------------------------------------------------------
@@ -349,12 +357,12 @@ class BenchNode:
         self.bus.send(msg)
         self.sent[name] = self.sent.get(name, 0) + 1
         if realtime_ns is not None:
-            self.trace.frame(msg, realtime_ns, tx=True)
+            self.trace.frame(msg, realtime_ns, tx=True, t_ready_ns=realtime_ns, t_rx_ns=NAN,
+                             bits=frame_bits(msg.arbitration_id, bytes(msg.data)))
         else:
-            seq = self.arbiter.submit(
-                ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data))
-            )
-            self._wire_pending[seq] = (msg, True)
+            bits = frame_bits(msg.arbitration_id, bytes(msg.data))
+            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits)
+            self._wire_pending[seq] = (msg, True, bits)
         if name == "IMU_RATE":
             self.imu_tx_ns[msg.data[1] & 0x0F] = ready_ns if realtime_ns is None else realtime_ns
         return msg
@@ -363,8 +371,9 @@ class BenchNode:
         """Resolve bus arbitration; record frames in wire order. Returns seq -> rx time."""
         rx: dict[int, int] = {}
         for d in self.arbiter.resolve(until_ns):
-            msg, tx = self._wire_pending.pop(d.seq)
-            self.trace.frame(msg, d.end_ns, tx=tx)
+            msg, tx, bits = self._wire_pending.pop(d.seq)
+            self.trace.frame(msg, d.end_ns, tx=tx, t_ready_ns=d.ready_ns, t_start_ns=d.start_ns,
+                             bits=bits)
             rx[d.seq] = d.end_ns
         return rx
 
@@ -383,7 +392,9 @@ class BenchNode:
             self.fsw_est_err_deg = quat_error_deg(self.plant.state[0:4], self.fsw_q_est)
             self.fsw_q_valid = bool(s["Valid"])
 
-    def _apply_command(self, s: dict[str, float], frame_index: int, t_rx_ns: int) -> None:
+    def _apply_command(self, s: dict[str, float], frame_index: int, t_rx_ns: int) -> bool:
+        """Deliver one THR_CMD frame to its valves at ``t_rx_ns``; True if any valve fires."""
+        fires = False
         for j in range(THRUSTERS_PER_CMD_FRAME):
             k = frame_index * THRUSTERS_PER_CMD_FRAME + j
             if k >= self.n_thr:
@@ -393,7 +404,18 @@ class BenchNode:
             self.plant.thrusters.command(t_rx_ns, k, on_ns)
             self.on_time_last[k] = on_s
             if on_ns > 0:
+                fires = True
                 self.pulses.row([t_rx_ns / NS_PER_S, (t_rx_ns + on_ns) / NS_PER_S, k])
+        return fires
+
+    def _chain(self, cycle: int, imu_counter: int, t_cmd_ns: int, t_fire_ns: int | None) -> None:
+        """One row of chains.csv: IMU sample -> last command frame -> first valve opening."""
+        t_imu = self.imu_tx_ns.get(imu_counter)
+        if t_imu is not None:
+            self.latency_ns.append(t_cmd_ns - t_imu)
+        t_open = NAN if t_fire_ns is None else (t_fire_ns + self.open_delay_ns) / NS_PER_S
+        self.chains.row([cycle, imu_counter, NAN if t_imu is None else t_imu / NS_PER_S,
+                         t_cmd_ns / NS_PER_S, t_open])
 
     # -- lockstep ----------------------------------------------------------------
     def wait_for_fsw(self) -> None:
@@ -438,6 +460,7 @@ class BenchNode:
                 self.trace.flush()
                 self.telemetry.flush()
                 self.pulses.flush()
+                self.chains.flush()
                 if self.progress is not None:
                     self.progress(t_k / NS_PER_S, duration_s)
         self._flush_wire()
@@ -465,10 +488,9 @@ class BenchNode:
             d = self.checker.check(msg)
             if d is None:
                 continue
-            seq = self.arbiter.submit(
-                ready_ns, msg.arbitration_id, frame_bits(msg.arbitration_id, bytes(msg.data))
-            )
-            self._wire_pending[seq] = (msg, False)
+            bits = frame_bits(msg.arbitration_id, bytes(msg.data))
+            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits)
+            self._wire_pending[seq] = (msg, False, bits)
             s: dict[str, float] = d.signals
             if d.name.startswith("THR_CMD_"):
                 if int(s["Cycle"]) != k % CYCLE_MODULUS:
@@ -495,16 +517,18 @@ class BenchNode:
         if not got:
             return
         t_last = 0
+        t_fire: int | None = None
         for index, seq, s in sorted(got):
             t_rx = rx[seq]
             t_last = max(t_last, t_rx)
-            self._apply_command(s, index, t_rx)
+            if self._apply_command(s, index, t_rx) and (t_fire is None or t_rx < t_fire):
+                t_fire = t_rx
         self.last_cmd_ns = t_last
         if self.watchdog_tripped:
             self.trace.event(t_last, "valve_watchdog_cleared")
             self.watchdog_tripped = False
-        if imu_counter is not None and imu_counter in self.imu_tx_ns:
-            self.latency_ns.append(t_last - self.imu_tx_ns[imu_counter])
+        if imu_counter is not None:
+            self._chain(k, imu_counter, t_last, t_fire)
 
     # -- realtime ----------------------------------------------------------------
     def run_realtime(self, duration_s: float, clock: Clock | None = None) -> None:
@@ -528,33 +552,43 @@ class BenchNode:
             wait_s = max(0.0, (self.plant.t_ns + STEP_NS - clock.now_ns()) / NS_PER_S)
             msg = self.bus.recv(timeout=wait_s)
             while msg is not None:
-                self._on_realtime_frame(msg, clock.now_ns())
+                self._on_realtime_frame(msg, clock)
                 msg = self.bus.recv(timeout=0.0)
             if self.plant.t_ns >= next_progress:
                 self.trace.flush()
                 self.telemetry.flush()
                 self.pulses.flush()
+                self.chains.flush()
                 if self.progress is not None:
                     self.progress(self.plant.t_ns / NS_PER_S, duration_s)
                 next_progress += 5 * self.period_ns
         self.wall_s = clock.now_ns() / NS_PER_S
         self.trace.event(self.plant.t_ns, "run_finished", late_steps=self.late_steps)
 
-    def _on_realtime_frame(self, msg: can.Message, t_ns: int) -> None:
+    def _on_realtime_frame(self, msg: can.Message, clock: Clock) -> None:
+        t_ns = clock.now_ns()
         d = self.checker.check(msg)
         if d is None:
             return
-        self.trace.frame(msg, t_ns, tx=False)
+        tx_wall = getattr(msg, "tx_timestamp", None)  # the portable bus carries the sender's time
+        self.trace.frame(
+            msg, t_ns, tx=False,
+            t_ready_ns=NAN if tx_wall is None else clock.from_wall_ns(tx_wall),
+            t_rx_ns=clock.from_wall_ns(msg.timestamp) if msg.timestamp > 0 else t_ns,
+            bits=frame_bits(msg.arbitration_id, bytes(msg.data)),
+        )
         s: dict[str, float] = d.signals
         if d.name.startswith("THR_CMD_"):
             t_apply = max(t_ns, self.plant.t_ns)
-            self._apply_command(s, int(d.name[-1]), t_apply)
+            index = int(d.name[-1])
+            if self._apply_command(s, index, t_apply):
+                self._rt_fire_ns = t_apply if self._rt_fire_ns is None else self._rt_fire_ns
             self.last_cmd_ns = t_apply
             self.watchdog_tripped = False
             self.fsw_silent = False
-            c = int(s["ImuCounter"])
-            if d.name == f"THR_CMD_{self.n_cmd_frames - 1}" and c in self.imu_tx_ns:
-                self.latency_ns.append(t_ns - self.imu_tx_ns[c])
+            if index == self.n_cmd_frames - 1:
+                self._chain(int(s["Cycle"]), int(s["ImuCounter"]), t_ns, self._rt_fire_ns)
+                self._rt_fire_ns = None
         else:
             self._on_fsw_frame(d.name, s)
 
@@ -626,6 +660,7 @@ class BenchNode:
         self.trace.close()
         self.telemetry.close()
         self.pulses.close()
+        self.chains.close()
         summary = self.summary(sim_time_s)
         (self.run_dir / "summary.json").write_text(
             json.dumps(summary, indent=2) + "\n", encoding="utf-8"

@@ -6,6 +6,13 @@
   read it; flushed once per control cycle, so a crash loses at most one cycle.
 * ``telemetry.csv`` — one row per telemetry sample (truth, sensors, estimates, commands);
   a header row names each column with its unit; flushed per cycle.
+* ``frames.csv`` — one row per frame of the trace, same order: when it was queued for
+  transmission (``t_ready_s``), when it won arbitration (``t_start_s``), when it was received
+  (``t_rx_s``), ID, DLC, bits on the wire, ``tx`` (1 = sent by the bench) and alive counter.
+  Lockstep: modelled times; realtime: measured (``nan`` where the bench cannot know, e.g.
+  when the flight software received a bench frame, or a sender's time on SocketCAN).
+* ``chains.csv`` — per control cycle, the end-to-end chain IMU sample -> command -> valve:
+  newest IMU_RATE used (its transmit time), last THR_CMD reception, first valve opening.
 * ``events.jsonl`` — one JSON object per event (faults, watchdog, stalls), flushed per line.
 
 No clock is read here: every timestamp is passed in.
@@ -21,6 +28,10 @@ from typing import IO, Any
 import can
 
 NS_PER_S = 1e9
+NAN = float("nan")
+COUNTER_MASK = 0x0F
+FRAME_COLUMNS = ["t_ready_s", "t_start_s", "t_rx_s", "id", "dlc", "bits", "tx", "counter"]
+CHAIN_COLUMNS = ["cycle", "imu_counter", "t_imu_tx_s", "t_cmd_rx_s", "t_valve_open_s"]
 NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at 1e4 s
 
 
@@ -31,10 +42,22 @@ class TraceRecorder:
         self.path = run_dir / "trace.asc"
         self._writer = can.ASCWriter(str(self.path), channel=1)
         self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
+        self._frames = TelemetryWriter(run_dir / "frames.csv", FRAME_COLUMNS)
         self.frames_written = 0
 
-    def frame(self, msg: can.Message, t_ns: int, tx: bool) -> None:
-        """Record ``msg`` at time ``t_ns``; ``tx`` = sent by the bench."""
+    def frame(
+        self, msg: can.Message, t_ns: int, tx: bool, *, t_ready_ns: float = NAN,
+        t_start_ns: float = NAN, t_rx_ns: float | None = None, bits: int = 0,
+    ) -> None:
+        """Record ``msg`` in the trace at ``t_ns`` (``tx`` = sent by the bench) and its timing row.
+
+        ``t_rx_ns`` defaults to ``t_ns``; pass ``NAN`` when the reception time is unknown.
+        """
+        data = msg.data
+        counter = data[1] & COUNTER_MASK if len(data) > 1 else -1
+        self._frames.row([t_ready_ns / NS_PER_S, t_start_ns / NS_PER_S,
+                          (t_ns if t_rx_ns is None else t_rx_ns) / NS_PER_S,
+                          msg.arbitration_id, msg.dlc, bits, int(tx), counter])
         rec = can.Message(
             timestamp=t_ns / NS_PER_S,
             arbitration_id=msg.arbitration_id,
@@ -55,12 +78,14 @@ class TraceRecorder:
         self._events.flush()
 
     def flush(self) -> None:
-        """Flush the trace to disk."""
+        """Flush the trace and the frame timing to disk."""
         self._writer.file.flush()
+        self._frames.flush()
 
     def close(self) -> None:
-        """Finish both files."""
+        """Finish every file."""
         self._writer.stop()
+        self._frames.close()
         self._events.close()
 
 

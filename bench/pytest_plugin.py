@@ -1,0 +1,1 @@
+"""pytest plugin of thruster-hil (placeholder; being written)."""
