@@ -11,6 +11,7 @@ the PNG plots, even when the flight software dies.
 
 from __future__ import annotations
 
+import ctypes
 import json
 import os
 import shlex
@@ -35,6 +36,7 @@ DEFAULT_FSW_CMD = (
     "--config {config} --stats {stats}"
 )
 FSW_TERM_TIMEOUT_S = 5.0
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
 
 @dataclass(frozen=True)
@@ -63,6 +65,16 @@ def _fsw_argv(template: str, opts: RunOptions, config: Path, stats: Path) -> lis
         ]
     except (KeyError, IndexError, ValueError) as exc:
         raise RunError(f"--fsw-cmd {template!r}: bad placeholder ({exc})") from exc
+
+
+def _die_with_parent() -> None:
+    """In the child: ask Linux for SIGTERM when the bench process dies (even by SIGKILL).
+
+    Elsewhere (macOS) this is a no-op; the flight software then notices the silence itself.
+    """
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 def _stop(proc: subprocess.Popen[bytes]) -> int | None:
@@ -105,6 +117,7 @@ def run_scenario(
                 stdout=log,
                 stderr=subprocess.STDOUT,
                 env=env,
+                preexec_fn=_die_with_parent,
             )
             log.close()
             node.fsw_alive = lambda: proc is not None and proc.poll() is None
