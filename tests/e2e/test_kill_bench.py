@@ -1,0 +1,90 @@
+"""SIGKILL of the bench mid-run: its files stay readable and the flight software does not linger."""
+
+from __future__ import annotations
+
+import os
+import selectors
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import can
+import pytest
+
+from tests.e2e.conftest import QUICKSTART, REPO, unique_bus
+
+pytestmark = pytest.mark.slow
+
+DEADLINE_S = 60.0
+KILL_AFTER_PERCENT = 30.0
+
+
+def _processes_mentioning(text: str) -> list[int]:
+    pids = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                if text in (entry / "cmdline").read_bytes().decode(errors="replace"):
+                    pids.append(int(entry.name))
+            except OSError:
+                continue
+    return pids
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+def test_sigkill_of_bench_leaves_readable_files_and_no_orphan(
+    tmp_path: Path, runtime_dir: Path
+) -> None:
+    """After kill -9 of the bench: trace and telemetry parse, and the flight software exits."""
+    out = tmp_path / "run"
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "bench.cli",
+            "run",
+            str(QUICKSTART),
+            "--bus",
+            unique_bus(),
+            "--out",
+            str(out),
+        ],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert p.stderr is not None
+    sel = selectors.DefaultSelector()
+    sel.register(p.stderr, selectors.EVENT_READ)
+    while True:  # wait for real progress lines, then kill
+        assert sel.select(timeout=DEADLINE_S), "no progress from the run"
+        line = p.stderr.readline()
+        assert line, "run ended before it could be killed"
+        if line.startswith("progress") and float(line.split()[1]) >= KILL_AFTER_PERCENT:
+            break
+    p.send_signal(signal.SIGKILL)
+    p.wait(DEADLINE_S)
+    p.stderr.close()
+    frames = list(can.LogReader(str(out / "trace.asc")))
+    assert len(frames) > 1000
+    rows = (out / "telemetry.csv").read_text().splitlines()
+    assert len(rows) > 100 and all(len(r.split(",")) == len(rows[0].split(",")) for r in rows[1:-1])
+    # the flight-software child got SIGTERM from the kernel and wrote its statistics
+    for pid in _processes_mentioning(str(out / "fsw_config.json")):
+        try:
+            fd = os.pidfd_open(pid)
+        except ProcessLookupError:
+            continue
+        try:  # the pidfd becomes readable when the process exits
+            waiter = selectors.DefaultSelector()
+            waiter.register(fd, selectors.EVENT_READ)
+            assert waiter.select(timeout=DEADLINE_S), f"flight software {pid} still running"
+            waiter.close()
+        finally:
+            os.close(fd)
+    assert _processes_mentioning(str(out / "fsw_config.json")) == []
+    assert (out / "fsw_stats.json").exists()
