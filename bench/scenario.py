@@ -379,8 +379,32 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     )
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate the scenario file at ``path``."""
+def apply_overrides(data: dict[str, Any], overrides: list[str], source: str) -> None:
+    """Apply ``KEY=VALUE`` overrides (dotted keys, TOML values) to parsed scenario data in place.
+
+    ``bus.bitrate_bps=125000``, ``flight_sw.modulator.km=10.0``, ``manoeuvre.t_start_s=2``.
+    A value that is not valid TOML is taken as a string. Errors name the override.
+    """
+    for item in overrides:
+        key, sep, text = item.partition("=")
+        if not sep or not key:
+            raise ConfigError(source, "--set", item, "KEY=VALUE with a dotted KEY")
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text
+        table = data
+        parts = key.split(".")
+        for part in parts[:-1]:
+            nxt = table.setdefault(part, {})
+            if not isinstance(nxt, dict):
+                raise ConfigError(source, key, item, f"{part!r} to be a table")
+            table = nxt
+        table[parts[-1]] = value
+
+
+def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:
+    """Read and validate the scenario file at ``path``, after ``KEY=VALUE`` overrides."""
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
@@ -392,4 +416,5 @@ def load_scenario(path: str | Path) -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(str(p), "<syntax>", str(exc), "valid TOML") from exc
+    apply_overrides(data, overrides or [], str(p))
     return parse_scenario(data, str(p))

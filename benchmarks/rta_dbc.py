@@ -24,6 +24,7 @@ from dbc import DBC_PATH, load_database
 
 BITRATES_BPS = (125_000, 500_000, 1_000_000)
 US_PER_S = 1_000_000
+MS_PER_S = 1_000
 DECIMALS = 6  # rounding of printed floats (µs values are multiples of 1 ns anyway)
 
 
@@ -39,7 +40,7 @@ def main() -> int:
         messages = {
             name: {
                 "can_id": r.can_id,
-                "period_ms": round(periods_s[name] * 1e3, DECIMALS),
+                "period_ms": round(periods_s[name] * MS_PER_S, DECIMALS),
                 "frame_bits": r.frame_bits,
                 "C_us": round(r.transmission_time_s * US_PER_S, DECIMALS),
                 "R_us": round(r.response_time_s * US_PER_S, DECIMALS),

@@ -120,3 +120,13 @@ def test_fuzzed_scenarios_raise_only_config_errors() -> None:
             table = table[key]
         with contextlib.suppress(ConfigError):
             parse_scenario(data, "fuzz.toml")
+
+
+def test_overrides_set_nested_keys_and_are_validated() -> None:
+    """KEY=VALUE overrides reach nested tables as TOML values and are validated like the file."""
+    sc = load_scenario(QUICKSTART, ["bus.bitrate_bps=125000", "flight_sw.modulator.km=10.0"])
+    assert sc.bus.bitrate_bps == 125_000 and sc.flight_sw["modulator"]["km"] == 10.0
+    with pytest.raises(ConfigError, match=r"bus\.bitrate_bps"):
+        load_scenario(QUICKSTART, ["bus.bitrate_bps=fast"])
+    with pytest.raises(ConfigError, match="KEY=VALUE"):
+        load_scenario(QUICKSTART, ["bitrate"])
