@@ -2,8 +2,11 @@
 
 Subcommands: ``run SCENARIO`` (bench + flight software as two processes, lockstep or
 realtime), ``bench SCENARIO`` (the bench alone, for external flight software or hardware
-on the same bus), ``report RUN_DIR`` (redraw plots, print the summary). Exit codes:
-0 pass, 1 the run's expectations failed, 2 bad input (scenario, options), 3 run error.
+on the same bus), ``report RUN_DIR`` (redraw plots, print the summary), ``timing RUN_DIR``
+(per-message timing, chains, bus load, worst-case bounds; ``timing --live --bus SPEC``
+measures a running bus). Exit codes: 0 pass, 1 the run's expectations failed (``timing
+--strict``: a measured latency above its bound), 2 bad input (scenario, options), 3 run
+error.
 """
 
 from __future__ import annotations
@@ -113,6 +116,54 @@ def _cmd_report(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_timing(args: argparse.Namespace) -> int:
+    from bench.analysis.live import LiveOptions, live_timing
+    from bench.analysis.report import format_report, write_histograms, write_json
+    from bench.analysis.timing import RunTiming, TimingOptions
+
+    if args.live == (args.run_dir is not None):
+        raise ConfigError("timing", "RUN_DIR/--live", args.run_dir, "a run folder or --live")
+    options = TimingOptions(
+        window_ms=args.window_ms,
+        cycle_abs_tolerance_ms=None if args.abs_tol_ms < 0 else args.abs_tol_ms,
+        cycle_rel_tolerance_pct=None if args.rel_tol_pct < 0 else args.rel_tol_pct,
+    )
+    if args.live:
+        bus = args.bus or default_bus_spec()
+        BusSpec.parse(bus)
+        live = LiveOptions(args.duration, args.first_frame_timeout, args.bitrate)
+
+        def listening() -> None:
+            print(
+                f"listening on {bus}: {live.duration_s:g} s from the first frame "
+                f"(waiting up to {live.first_frame_timeout_s:g} s for it)",
+                file=sys.stderr,
+                flush=True,
+            )
+
+        rt, cap = live_timing(bus, live, options, listening=listening)
+        extra = {"bus": bus, "error_frames": cap.error_frames, "fd_frames": cap.fd_frames}
+        if args.json:
+            print(json.dumps({**rt.to_dict(), **extra}, indent=2))
+        else:
+            print(format_report(rt))
+            print(
+                f"bus {bus}: {len(cap.frames)} frames, {cap.error_frames} error frames, "
+                f"{cap.fd_frames} CAN FD frames (not timed)"
+            )
+    else:
+        run_dir = Path(args.run_dir)
+        rt = RunTiming.load(run_dir, options)
+        written = [write_json(rt, run_dir), *write_histograms(rt, run_dir)]
+        if args.json:
+            print(json.dumps(rt.to_dict(), indent=2))
+        else:
+            print(format_report(rt))
+            for p in written:
+                print(f"wrote {p}")
+    return EXIT_FAILED if args.strict and rt.flagged() else EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of ``thruster-hil``."""
     p = argparse.ArgumentParser(prog="thruster-hil", description=__doc__.split("\n")[0])
@@ -140,7 +191,74 @@ def build_parser() -> argparse.ArgumentParser:
             )
     rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
     rp.add_argument("run_dir")
+    _add_timing_parser(sub)
     return p
+
+
+def _add_timing_parser(sub: Any) -> None:
+    from bench.analysis.defaults import (
+        DEFAULT_CYCLE_ABS_TOLERANCE_MS,
+        DEFAULT_CYCLE_REL_TOLERANCE_PCT,
+        DEFAULT_FIRST_FRAME_TIMEOUT_S,
+        DEFAULT_LIVE_DURATION_S,
+        DEFAULT_WINDOW_MS,
+    )
+
+    t = sub.add_parser(
+        "timing",
+        help="timing of a run folder (table, timing.json, histograms) or of a live bus",
+        description="Per message: count, period mean and jitter, latency p50/p99/max, "
+        "worst-case bound, missed cycles, cycle-time violations; the IMU->command->valve "
+        "chain; bus load per window and per node.",
+    )
+    t.add_argument("run_dir", nargs="?", help="run folder (omit with --live)")
+    t.add_argument(
+        "--window-ms",
+        type=float,
+        default=DEFAULT_WINDOW_MS,
+        help=f"bus-load window [ms] (default {DEFAULT_WINDOW_MS:g})",
+    )
+    t.add_argument(
+        "--abs-tol-ms",
+        type=float,
+        default=DEFAULT_CYCLE_ABS_TOLERANCE_MS,
+        help="absolute cycle-time window, ± ms around GenMsgCycleTime; negative: "
+        f"off (default {DEFAULT_CYCLE_ABS_TOLERANCE_MS:g})",
+    )
+    t.add_argument(
+        "--rel-tol-pct",
+        type=float,
+        default=DEFAULT_CYCLE_REL_TOLERANCE_PCT,
+        help="relative cycle-time window, ± %% of GenMsgCycleTime; negative: off "
+        f"(default {DEFAULT_CYCLE_REL_TOLERANCE_PCT:g})",
+    )
+    t.add_argument("--json", action="store_true", help="print JSON instead of the table")
+    t.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit 1 if a measured latency is above its worst-case bound",
+    )
+    t.add_argument("--live", action="store_true", help="listen to a running bus instead")
+    t.add_argument("--bus", help="--live: bus spec INTERFACE:CHANNEL (default as for run)")
+    t.add_argument(
+        "--duration",
+        type=float,
+        default=DEFAULT_LIVE_DURATION_S,
+        help="--live: seconds to listen from the first frame "
+        f"(default {DEFAULT_LIVE_DURATION_S:g})",
+    )
+    t.add_argument(
+        "--first-frame-timeout",
+        type=float,
+        default=DEFAULT_FIRST_FRAME_TIMEOUT_S,
+        help="--live: seconds to wait for the first frame "
+        f"(default {DEFAULT_FIRST_FRAME_TIMEOUT_S:g})",
+    )
+    t.add_argument(
+        "--bitrate",
+        type=int,
+        help="--live: bitrate for the load estimate [bit/s] (default: the DBC's)",
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -149,6 +267,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "report":
             return _cmd_report(args)
+        if args.command == "timing":
+            return _cmd_timing(args)
         return _cmd_run(args, alone=args.command == "bench")
     except (ConfigError, BusError) as exc:
         print(f"thruster-hil: error: {exc}", file=sys.stderr)

@@ -30,7 +30,7 @@ import can
 import numpy as np
 from cantools.database.can import Database
 
-from bench.bus.timing import BusArbiter, frame_bits
+from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_time_ns
 from bench.metrics import expectation, latency_summary, pointing_metrics
 from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder
@@ -145,6 +145,7 @@ class BenchNode:
         self.n_thr = len(sc.thrusters)
         self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
         self.arbiter = BusArbiter(sc.bus.bitrate_bps)
+        self._intermission_ns = wire_time_ns(INTERMISSION_BITS, sc.bus.bitrate_bps)
         self.trace = TraceRecorder(run_dir)
         self.telemetry = TelemetryWriter(run_dir / "telemetry.csv", self._columns())
         self.chains = TelemetryWriter(run_dir / "chains.csv", CHAIN_COLUMNS)
@@ -372,9 +373,10 @@ class BenchNode:
         rx: dict[int, int] = {}
         for d in self.arbiter.resolve(until_ns):
             msg, tx, bits = self._wire_pending.pop(d.seq)
-            self.trace.frame(msg, d.end_ns, tx=tx, t_ready_ns=d.ready_ns, t_start_ns=d.start_ns,
+            t_rx = d.end_ns - self._intermission_ns  # received at the end of EOF
+            self.trace.frame(msg, t_rx, tx=tx, t_ready_ns=d.ready_ns, t_start_ns=d.start_ns,
                              bits=bits)
-            rx[d.seq] = d.end_ns
+            rx[d.seq] = t_rx
         return rx
 
     def _send_queue(self, realtime_ns: int | None = None) -> None:

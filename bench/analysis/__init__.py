@@ -2,20 +2,15 @@
 
 :mod:`bench.analysis.timing` holds the measurements (pure functions and :class:`RunTiming`),
 :mod:`bench.analysis.live` listens to a running bus, :mod:`bench.analysis.report` prints
-tables and draws histograms. ``thruster-hil timing`` and the pytest plugin use them.
+tables and draws histograms, :mod:`bench.analysis.defaults` the default settings.
+``thruster-hil timing`` and the pytest plugin (:mod:`bench.pytest_plugin`) use them.
+The names below are imported lazily, so ``bench.analysis.defaults`` stays light.
 """
 
 from __future__ import annotations
 
-from bench.analysis.timing import (
-    BusLoad,
-    ChainTiming,
-    LoadFigures,
-    MessageTiming,
-    Percentiles,
-    RunTiming,
-    TimingOptions,
-)
+import importlib
+from typing import Any
 
 __all__ = [
     "BusLoad",
@@ -26,3 +21,9 @@ __all__ = [
     "RunTiming",
     "TimingOptions",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in __all__:
+        return getattr(importlib.import_module("bench.analysis.timing"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

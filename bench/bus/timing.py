@@ -81,25 +81,25 @@ ACK_DELIMITER_BITS = 1
 EOF_BITS = 7
 INTERMISSION_BITS = 3
 CAN_MAX_DATA_BYTES = 8
+FLAG_BITS = 1  # each one-bit field: RTR, SRR, IDE, r0, r1, FDF, res, RRS, BRS, ESI
 UNSTUFFED_TAIL_BITS = (  # CRC delimiter, ACK slot + delimiter, EOF, intermission = 13
     CRC_DELIMITER_BITS + ACK_SLOT_BITS + ACK_DELIMITER_BITS + EOF_BITS + INTERMISSION_BITS
 )
 # bits SOF..DLC ("header", Linux CAN_FRAME_HEADER_*_BITS): SFF = SOF, ID, RTR, IDE, r0, DLC
-CAN_HEADER_SFF_BITS = SOF_BITS + BASE_ID_BITS + 3 + DLC_BITS  # 19
+CAN_HEADER_SFF_BITS = SOF_BITS + BASE_ID_BITS + 3 * FLAG_BITS + DLC_BITS  # 19
 CAN_HEADER_EFF_BITS = (  # SOF, ID, SRR, IDE, ID ext, RTR, r1, r0, DLC = 39
-    SOF_BITS + BASE_ID_BITS + 2 + EXT_ID_BITS + 3 + DLC_BITS
+    SOF_BITS + BASE_ID_BITS + 2 * FLAG_BITS + EXT_ID_BITS + 3 * FLAG_BITS + DLC_BITS
 )
 
 # -- CAN FD ---------------------------------------------------------------------------------
 CANFD_MAX_DATA_BYTES = 64
 FD_DATA_LENGTHS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64)  # by DLC 0..15
 # arbitration phase SOF..BRS: SFF = SOF, ID, RRS, IDE, FDF, res, BRS (17)
-FD_ARBITRATION_SFF_BITS = SOF_BITS + BASE_ID_BITS + 5
+FD_ARBITRATION_SFF_BITS = SOF_BITS + BASE_ID_BITS + 5 * FLAG_BITS
 # EFF = SOF, ID, SRR, IDE, ID ext, RRS, FDF, res, BRS (36)
-FD_ARBITRATION_EFF_BITS = SOF_BITS + BASE_ID_BITS + 2 + EXT_ID_BITS + 4
-FD_ESI_BITS = 1
-FD_HEADER_SFF_BITS = FD_ARBITRATION_SFF_BITS + FD_ESI_BITS + DLC_BITS  # 22 (SOF..DLC)
-FD_HEADER_EFF_BITS = FD_ARBITRATION_EFF_BITS + FD_ESI_BITS + DLC_BITS  # 41
+FD_ARBITRATION_EFF_BITS = SOF_BITS + BASE_ID_BITS + 2 * FLAG_BITS + EXT_ID_BITS + 4 * FLAG_BITS
+FD_HEADER_SFF_BITS = FD_ARBITRATION_SFF_BITS + FLAG_BITS + DLC_BITS  # 22 (SOF..DLC, + ESI)
+FD_HEADER_EFF_BITS = FD_ARBITRATION_EFF_BITS + FLAG_BITS + DLC_BITS  # 41
 FD_STUFF_COUNT_BITS = 4  # 3-bit Gray code of (dynamic stuff bits mod 8) + parity
 CRC17_BITS = 17
 CRC21_BITS = 21
@@ -299,13 +299,12 @@ def _stuff_runs(bits: str) -> tuple[int, int]:
 
 
 @functools.lru_cache(maxsize=4096)
-def _fd_header(
-    can_id: int, dlc: int, extended: bool, brs: bool, esi: bool
-) -> tuple[str, int, int]:
+def _fd_header(can_id: int, dlc: int, extended: bool, brs: bool, esi: bool) -> tuple[str, int, int]:
     """Bits SOF..DLC of an FD frame, the length of SOF..BRS, and the stuff bits inside it.
 
-    The count excludes a stuff bit that follows BRS: it is sent after the switch, at the
-    data rate. Stuffing is causal, so the prefix's stuff bits are those of the full frame.
+    Stuffing is causal, so the prefix's stuff bits are those of the full frame. A stuff
+    bit after BRS would be sent at the data rate and is excluded; it cannot occur with BRS
+    set (res = 0, BRS = 1), and without BRS the split is not used.
     """
     if not 0 <= can_id < 1 << (BASE_ID_BITS + (EXT_ID_BITS if extended else 0)):
         raise ValueError(f"can_id={can_id:#x} does not fit a {'29' if extended else '11'}-bit ID")
@@ -473,6 +472,17 @@ class Delivery:
         return (*self.failed_ns, (self.start_ns, self.end_ns))
 
 
+class _Retry:
+    """Failed attempts still to come for one frame, their bus time, and their intervals."""
+
+    __slots__ = ("failed", "left", "wire_ns")
+
+    def __init__(self, left: int, wire_ns: int) -> None:
+        self.left = left
+        self.wire_ns = wire_ns
+        self.failed: list[tuple[int, int]] = []
+
+
 _PRIORITY = itemgetter(1, 2)  # (can_id, seq): lowest ID wins, then first submitted
 
 
@@ -498,8 +508,7 @@ class BusArbiter:
         self._busy_until_ns = 0
         # heap of (eligible_ns, can_id, seq, ready_ns, wire_ns, node)
         self._pending: list[tuple[int, int, int, int, int, str]] = []
-        # seq -> [failures left, failed-attempt wire_ns, failed intervals]
-        self._retries: dict[int, list] = {}  # type: ignore[type-arg]
+        self._retries: dict[int, _Retry] = {}  # frames submitted with failed_attempts
         self._bus_off: dict[str, list[tuple[int, int]]] = {}
         self._seq = 0
         self.busy_ns_total = 0
@@ -537,8 +546,7 @@ class BusArbiter:
         if failed_attempts:
             if failed_attempts < 0:
                 raise ValueError(f"failed_attempts={failed_attempts}: must be >= 0")
-            fail_ns = self._wire_ns(failed_attempt_bits(bits))
-            self._retries[seq] = [failed_attempts, fail_ns, []]
+            self._retries[seq] = _Retry(failed_attempts, self._wire_ns(failed_attempt_bits(bits)))
         heapq.heappush(self._pending, (ready_ns, can_id, seq, ready_ns, wire_ns, node))
         return seq
 
@@ -597,18 +605,18 @@ class BusArbiter:
                     heapq.heappush(pending, f)
             seq = win[2]
             retry = self._retries.get(seq)
-            if retry is not None and retry[0] > 0:  # this attempt fails
-                retry[0] -= 1
-                end = t + retry[1]
-                retry[2].append((t, end))
+            if retry is not None and retry.left > 0:  # this attempt fails
+                retry.left -= 1
+                end = t + retry.wire_ns
+                retry.failed.append((t, end))
                 self._busy_until_ns = end
-                self.busy_ns_total += retry[1]
-                self.error_ns_total += retry[1]
+                self.busy_ns_total += retry.wire_ns
+                self.error_ns_total += retry.wire_ns
                 heapq.heappush(pending, (end, *win[1:]))
                 continue
             failed: tuple[tuple[int, int], ...] = ()
             if retry is not None:
-                failed = tuple(retry[2])
+                failed = tuple(retry.failed)
                 del self._retries[seq]
             end = t + win[4]
             self._busy_until_ns = end
@@ -646,7 +654,7 @@ def busy_ns_per_window(
                 seg_end = min(b, t0_ns + (k + 1) * window_ns)
                 busy[k] += seg_end - a
                 a, k = seg_end, k + 1
-    return list(zip(starts, busy))
+    return list(zip(starts, busy, strict=True))
 
 
 def load_per_window(
@@ -678,9 +686,7 @@ def load_per_window_by_node(
     for d in deliveries:
         name = node_of[d.seq] if node_of is not None else d.node
         by_node.setdefault(name, []).append(d)
-    return {
-        name: load_per_window(ds, window_ns, t0_ns, t1_ns) for name, ds in by_node.items()
-    }
+    return {name: load_per_window(ds, window_ns, t0_ns, t1_ns) for name, ds in by_node.items()}
 
 
 def mean_peak_load(

@@ -39,13 +39,49 @@ Physical model (first-order valve dynamics with transport delays)
         I = Fmax[D − τr(1 − e^{−D/τr})] + Fmax(1 − e^{−D/τr})·τt
     (integral of the two exponentials above; the cut-off tail below 1e-9·Fmax is ignored).
 
-Faults (``set_fault``; DESIGN.md §7)
-    - ``"stuck_closed"``: the valve is driven closed from the fault time on and never
-      opens (any thrust in progress decays with the tail); the coil still energises and
-      reports current.
-    - ``"stuck_open"``: once the valve is (or next becomes) driven open it never closes,
-      whatever is commanded: full thrust after the opening transient.
-    - ``None`` clears the fault; the valve then follows the coil schedule again.
+Faults (``set_fault`` / ``clear_fault``; DESIGN.md §7)
+    Each fault is set and cleared at a simulation time ``t_ns`` (default: the time of the
+    last command or fault event); several may be active at once and combine. Setting an
+    active kind again replaces its parameters. The thrust below is the *physical* thrust
+    of the nozzle: the one ``thrust_N``/``stage_thrusts_N`` return, the rigid body feels
+    and the impulse and propellant bookkeeping integrates.
+
+    - ``"stuck_closed"`` (no parameter): the valve is driven closed from the fault time
+      on and never opens (any thrust in progress decays with the tail); the coil still
+      energises and reports current. Setting it clears ``stuck_open``.
+    - ``"stuck_open"`` (no parameter): once the valve is (or next becomes) driven open
+      it never closes, whatever is commanded: full thrust after the opening transient;
+      ``status`` reports it open with the coil off. Setting it clears ``stuck_closed``.
+    - ``"degraded"``, ``factor`` [-] in [0, 1]: from the fault time the thrust is
+      exactly ``factor`` × the nominal thrust (rise and tail included, so a pulse gives
+      ``factor`` × ``pulse_impulse_Ns``); models a partly blocked injector or a low feed
+      pressure. The thrust in progress is scaled at once; from a factor of 0 a later
+      factor restarts the transient from zero thrust.
+    - ``"delayed"``, ``extra_delay_s`` [s] ≥ 0: added to ``open_delay_s`` for every
+      opening not yet begun at the fault time (coil pulses starting later, and a pulse
+      still in its opening delay); models a sticky poppet or a weak drive voltage.
+      Clearing it lets a pending opening happen at max(clear time, nominal opening).
+    - ``"intermittent"``, ``dropout_probability`` [-] in [0, 1] (optional ``rng``, a
+      ``numpy.random.Generator``, else the one given to the constructor): each coil
+      pulse that starts (rising edge) while the fault is active is dropped with that
+      probability — one uniform draw per pulse, only while the fault is active, so runs
+      are reproducible from the seed. A dropped pulse gives no thrust, but its coil
+      energises and reports current (``status`` = (True, False, True)); counted in
+      ``dropped_pulses``. Clearing it lets the pulse in progress open.
+    - ``"leak"``, ``thrust_N`` [N] in (0, max_thrust_N]: a constant thrust added to the
+      valve's thrust, commanded or not, from the fault time (a step) until cleared;
+      the valve is then never idle, its impulse and propellant are booked like any
+      thrust, and ``status`` reports it open only above 10 % of Fmax.
+    - ``set_fault(None, t_ns)`` clears every fault; the valve then follows the coil
+      schedule again.
+    Misalignment changes the thrust *direction*, so it belongs to the thruster set
+    (``bench.valves.thruster_set``), not to the valve.
+
+    Implementation: the segments hold the physical thrust. A driven segment rises (time
+    constant τr) towards ``factor``·Fmax + leak, an undriven one decays (τt) towards the
+    leak; both keep the piecewise-exponential form, so an inactive fault costs nothing
+    and an active one adds no work per step. A segment whose thrust lies above its
+    target is decaying, below it rising; ``stage_thrusts_N`` relies on that.
 
 Units: seconds in parameters (suffix ``_s``), integer nanoseconds for times (``_ns``),
 newtons for thrust. Equation sources: first-order lag response (Ogata, "Modern Control
@@ -56,7 +92,10 @@ Mission Analysis and Design", §11.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from dbc.errors import ConfigError
 
@@ -70,7 +109,26 @@ NEVER_NS = 2**63 - 1
 """A time later than any simulation (idle_from_ns of a valve that never stops)."""
 FAULT_STUCK_CLOSED = "stuck_closed"
 FAULT_STUCK_OPEN = "stuck_open"
-FAULT_KINDS = frozenset({FAULT_STUCK_CLOSED, FAULT_STUCK_OPEN})
+FAULT_DEGRADED = "degraded"
+FAULT_DELAYED = "delayed"
+FAULT_INTERMITTENT = "intermittent"
+FAULT_LEAK = "leak"
+FAULT_PARAMS: Mapping[str, tuple[str, ...]] = {
+    FAULT_STUCK_CLOSED: (),
+    FAULT_STUCK_OPEN: (),
+    FAULT_DEGRADED: ("factor",),
+    FAULT_DELAYED: ("extra_delay_s",),
+    FAULT_INTERMITTENT: ("dropout_probability",),
+    FAULT_LEAK: ("thrust_N",),
+}
+"""Valve fault kinds and their required parameters (see the module docstring)."""
+FAULT_OPTIONAL_PARAMS: Mapping[str, tuple[str, ...]] = {FAULT_INTERMITTENT: ("rng",)}
+"""Optional parameters (not recorded in ``faults_active``)."""
+FAULT_KINDS = frozenset(FAULT_PARAMS)
+_STUCK_KINDS = frozenset({FAULT_STUCK_CLOSED, FAULT_STUCK_OPEN})
+NOMINAL_THRUST_FACTOR = 1.0
+FaultParams = dict[str, float]
+"""Recorded parameters of one active fault: name → value in the units of its name."""
 
 # A thrust segment: (t_start_ns, thrust at t_start [N], target thrust [N], 1/τ [1/ns]).
 _Segment = tuple[int, float, float, float]
@@ -83,6 +141,59 @@ def _require(ok: bool, source: str, key: str, value: object, expected: str) -> N
 
 def _is_real(value: object) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _fault_number(
+    source: str, key: str, value: object, lo: float, hi: float, expected: str = ""
+) -> float:
+    """``value`` as a finite float in [lo, hi], or ConfigError naming ``key``."""
+    ok = _is_real(value) and math.isfinite(value) and lo <= value <= hi  # type: ignore[arg-type]
+    _require(ok, source, key, value, expected or f"a number in [{lo:g}, {hi:g}]")
+    return float(value)  # type: ignore[arg-type]
+
+
+def check_fault_params(
+    kind: str, params: Mapping[str, object], source: str, max_thrust_N: float
+) -> FaultParams:
+    """Validate the parameters of a valve fault ``kind``; returns the recorded ones.
+
+    Unknown or missing names and out-of-range values raise ``ConfigError(source, name,
+    value, expected)``; the optional ``rng`` is checked to be a numpy Generator but not
+    returned.
+    """
+    _require(kind in FAULT_KINDS, source, "kind", kind, f"None or one of {sorted(FAULT_KINDS)}")
+    required = FAULT_PARAMS[kind]
+    allowed = required + FAULT_OPTIONAL_PARAMS.get(kind, ())
+    for key, value in params.items():
+        _require(
+            key in allowed,
+            source,
+            key,
+            value,
+            f"no such parameter for {kind!r} (its parameters: {list(allowed) or 'none'})",
+        )
+    for key in required:
+        _require(key in params, source, key, None, f"a value (required by {kind!r})")
+    if "rng" in params:
+        rng = params["rng"]
+        _require(isinstance(rng, np.random.Generator), source, "rng", rng, "a numpy Generator")
+    out: FaultParams = {}
+    if kind == FAULT_DEGRADED:
+        out["factor"] = _fault_number(source, "factor", params["factor"], 0.0, 1.0)
+    elif kind == FAULT_DELAYED:
+        out["extra_delay_s"] = _fault_number(
+            source, "extra_delay_s", params["extra_delay_s"], 0.0, math.inf, "a finite number >= 0"
+        )
+    elif kind == FAULT_INTERMITTENT:
+        out["dropout_probability"] = _fault_number(
+            source, "dropout_probability", params["dropout_probability"], 0.0, 1.0
+        )
+    elif kind == FAULT_LEAK:
+        value = params["thrust_N"]
+        expected = f"a number in (0, {max_thrust_N:g}] (at most max_thrust_N)"
+        out["thrust_N"] = _fault_number(source, "thrust_N", value, 0.0, max_thrust_N, expected)
+        _require(out["thrust_N"] > 0.0, source, "thrust_N", value, expected)
+    return out
 
 
 @dataclass(frozen=True)
@@ -135,44 +246,86 @@ class ValveParams:
 class Valve:
     """One valve and its drive electronics (see the module docstring for the semantics).
 
+    ``rng`` (optional) is the generator of the ``intermittent`` fault's drop-outs when
+    ``set_fault`` is not given one.
+
     Attributes (read-only for callers):
-        params        the ``ValveParams``
-        fault         None, ``"stuck_closed"`` or ``"stuck_open"``
-        openings      number of coil rising edges so far
-        idle_from_ns  from this time on the thrust is exactly 0 unless a new command
-                      arrives (``NEVER_NS`` while a rise is pending or the valve is stuck open)
+        params          the ``ValveParams``
+        openings        number of coil rising edges so far
+        dropped_pulses  coil pulses dropped by the ``intermittent`` fault so far
+        idle_from_ns    from this time on the thrust is exactly 0 unless a new command
+                        arrives (``NEVER_NS`` while a rise is pending, the valve is stuck
+                        open or leaking)
     """
 
     __slots__ = (
+        "_coil_dropped",
         "_coil_off_ns",
+        "_coil_od_ns",
         "_coil_on_ns",
+        "_drive_plan",
+        "_dropout_p",
+        "_dropout_rng",
+        "_extra_delay_ns",
+        "_factor",
+        "_faults",
         "_half_ns",
         "_half_rise",
         "_half_tail",
         "_last_event_ns",
+        "_leak_N",
         "_past_pulses",
+        "_rng",
         "_segments",
-        "fault",
+        "_stuck",
+        "dropped_pulses",
         "idle_from_ns",
         "openings",
         "params",
     )
 
-    def __init__(self, params: ValveParams) -> None:
+    def __init__(self, params: ValveParams, rng: np.random.Generator | None = None) -> None:
+        if rng is not None and not isinstance(rng, np.random.Generator):
+            raise ConfigError("Valve", "rng", rng, "None or a numpy Generator")
         self.params = params
-        self.fault: str | None = None
+        self._rng = rng
         self.openings = 0
+        self.dropped_pulses = 0
         self.idle_from_ns = -NEVER_NS
         self._coil_on_ns = -NEVER_NS
         self._coil_off_ns = -NEVER_NS
+        self._coil_od_ns = params.open_delay_ns  # opening delay of the coil pulse
+        self._coil_dropped = False  # the coil pulse was dropped (intermittent)
         self._last_event_ns = -NEVER_NS
-        # Earlier coil pulses whose delayed closing may still lie in the future.
-        self._past_pulses: list[tuple[int, int]] = []
+        # Earlier coil pulses whose delayed closing may still lie in the future:
+        # (coil on, coil off, opening delay [ns], dropped).
+        self._past_pulses: list[tuple[int, int, int, bool]] = []
         self._segments: list[_Segment] = [(-NEVER_NS, 0.0, 0.0, params.inv_tail_tau_per_ns)]
+        # Planned drive state from the last event on: (time, driven open) edges.
+        self._drive_plan: list[tuple[int, bool]] = [(-NEVER_NS, False)]
+        # Faults: recorded parameters by kind (insertion order = order set) and their
+        # effect on the model, nominal values when none is active.
+        self._faults: dict[str, FaultParams] = {}
+        self._stuck: str | None = None
+        self._factor = NOMINAL_THRUST_FACTOR
+        self._extra_delay_ns = 0
+        self._dropout_p = 0.0
+        self._dropout_rng: np.random.Generator | None = None
+        self._leak_N = 0.0
         # Cache of stage_thrusts_N: half step [ns] and its decay factors e^{-half/τ}.
         self._half_ns = 0
         self._half_rise = 1.0
         self._half_tail = 1.0
+
+    @property
+    def fault(self) -> str | None:
+        """None without fault, else the active kinds joined by ``+`` in the order set."""
+        return "+".join(self._faults) if self._faults else None
+
+    @property
+    def faults_active(self) -> dict[str, FaultParams]:
+        """Active faults: kind → recorded parameters (a copy; empty when healthy)."""
+        return {k: dict(v) for k, v in self._faults.items()}
 
     # --- queries --------------------------------------------------------------------
     def thrust_N(self, t_ns: int) -> float:
@@ -220,14 +373,17 @@ class Valve:
             self._half_rise = math.exp(-half * self.params.inv_rise_tau_per_ns)
             self._half_tail = math.exp(-half * self.params.inv_tail_tau_per_ns)
         a = (f0 - target) * math.exp((t0 - t_ns) * k)
-        if target == 0.0:
+        if a > 0.0:  # above the target: decaying, towards 0 or a leak (module docstring)
             e = self._half_tail
-            cut = self.params.cutoff_N
-            fa = a if a > cut else 0.0
-            fm = a * e
-            fb = fm * e
-            return (fa, fm if fm > cut else 0.0, fb if fb > cut else 0.0)
-        e = self._half_rise
+            if target == 0.0:
+                cut = self.params.cutoff_N
+                fa = a if a > cut else 0.0
+                fm = a * e
+                fb = fm * e
+                return (fa, fm if fm > cut else 0.0, fb if fb > cut else 0.0)
+            am = a * e
+            return (target + a, target + am, target + am * e)
+        e = self._half_rise  # rising (or constant: a == 0)
         am = a * e
         return (target + a, target + am, target + am * e)
 
@@ -262,28 +418,51 @@ class Valve:
             self._coil_off_ns = max(t_ns + on_time_ns, on_ns + self.params.min_on_ns)
         else:
             if off_ns > on_ns:
-                self._past_pulses.append((on_ns, off_ns))
+                self._past_pulses.append((on_ns, off_ns, self._coil_od_ns, self._coil_dropped))
             self._coil_on_ns = t_ns
             self._coil_off_ns = t_ns + max(on_time_ns, self.params.min_on_ns)
+            self._coil_od_ns = self.params.open_delay_ns + self._extra_delay_ns
+            dropped = False
+            if self._dropout_rng is not None:  # intermittent: one draw per coil pulse
+                dropped = float(self._dropout_rng.random()) < self._dropout_p
+                self.dropped_pulses += dropped
+            self._coil_dropped = dropped
             self.openings += 1
         self._replan(t_ns, f_now, driven)
 
-    def set_fault(self, kind: str | None, t_ns: int | None = None) -> None:
-        """Inject (``"stuck_closed"``, ``"stuck_open"``) or clear (None) a valve fault.
+    def set_fault(self, kind: str | None, t_ns: int | None = None, **params: object) -> None:
+        """Inject fault ``kind`` with its ``params`` at ``t_ns``, or clear all faults (None).
 
-        The fault takes effect at ``t_ns`` (default: the time of the last command or
-        fault event, i.e. retroactively since then); ``t_ns`` must not precede it.
+        Kinds and parameters: see the module docstring (``FAULT_PARAMS``); bad ones raise
+        ``ConfigError``. The fault takes effect at ``t_ns`` (default: the time of the last
+        command or fault event, i.e. retroactively since then); ``t_ns`` must not precede
+        it. Setting an active kind again replaces its parameters.
         """
-        if kind is not None and kind not in FAULT_KINDS:
+        source = f"Valve.set_fault({kind!r})"
+        if kind is None:
+            if params:
+                key = next(iter(params))
+                raise ConfigError(source, key, params[key], "no parameter when clearing (None)")
+            self._event(t_ns, {k: None for k in self._faults})
+            return
+        recorded = check_fault_params(kind, params, source, self.params.max_thrust_N)
+        if kind == FAULT_INTERMITTENT:
+            rng = params.get("rng", self._rng)
+            if rng is None:
+                raise ConfigError(
+                    source, "rng", None, "a numpy Generator (to set_fault or to Valve())"
+                )
+            self._event(t_ns, {kind: recorded}, rng)  # type: ignore[arg-type]
+        else:
+            self._event(t_ns, {kind: recorded})
+
+    def clear_fault(self, kind: str, t_ns: int | None = None) -> None:
+        """Clear fault ``kind`` at ``t_ns`` (default as ``set_fault``); a no-op if inactive."""
+        if kind not in FAULT_KINDS:
             raise ConfigError(
-                "Valve.set_fault", "kind", kind, f"None or one of {sorted(FAULT_KINDS)}"
+                f"Valve.clear_fault({kind!r})", "kind", kind, f"one of {sorted(FAULT_KINDS)}"
             )
-        t = self._last_event_ns if t_ns is None else t_ns
-        self._check_time(t)
-        f_now = self.thrust_N(t)
-        driven = self._driven_at(t)
-        self.fault = kind
-        self._replan(t, f_now, driven)
+        self._event(t_ns, {kind: None})
 
     @staticmethod
     def pulse_impulse_Ns(params: ValveParams, on_time_s: float) -> float:
@@ -307,24 +486,85 @@ class Valve:
                 f"valve events must be in time order: t_ns={t_ns} < last {self._last_event_ns}"
             )
 
+    def _event(
+        self,
+        t_ns: int | None,
+        changes: Mapping[str, FaultParams | None],
+        rng: np.random.Generator | None = None,
+    ) -> None:
+        """Apply fault changes (kind → new parameters, None = clear) at ``t_ns`` and replan.
+
+        The thrust in progress is carried over: its valve part (thrust − leak) is scaled
+        by the ratio of the thrust factors, and the new leak is added.
+        """
+        t = self._last_event_ns if t_ns is None else t_ns
+        self._check_time(t)
+        f_now = self.thrust_N(t)
+        driven = self._driven_at(t)
+        factor_before, leak_before = self._factor, self._leak_N
+        faults = self._faults
+        for kind, recorded in changes.items():
+            faults.pop(kind, None)
+            if recorded is not None:
+                if kind in _STUCK_KINDS:
+                    faults.pop(FAULT_STUCK_OPEN, None)
+                    faults.pop(FAULT_STUCK_CLOSED, None)
+                faults[kind] = recorded
+        self._stuck = next((k for k in faults if k in _STUCK_KINDS), None)
+        self._factor = faults[FAULT_DEGRADED]["factor"] if FAULT_DEGRADED in faults else 1.0
+        self._leak_N = faults[FAULT_LEAK]["thrust_N"] if FAULT_LEAK in faults else 0.0
+        extra_s = faults[FAULT_DELAYED]["extra_delay_s"] if FAULT_DELAYED in faults else 0.0
+        extra_ns = round(extra_s * NS_PER_S)
+        if extra_ns != self._extra_delay_ns:
+            self._extra_delay_ns = extra_ns
+            self._retime_pending_openings(t)
+        if FAULT_INTERMITTENT in faults:
+            self._dropout_p = faults[FAULT_INTERMITTENT]["dropout_probability"]
+            if rng is not None:
+                self._dropout_rng = rng
+        else:
+            self._dropout_p = 0.0
+            self._dropout_rng = None
+            if self._coil_on_ns <= t < self._coil_off_ns:
+                self._coil_dropped = False  # the pulse in progress may now open
+        valve_part = max(0.0, f_now - leak_before)
+        if self._factor != factor_before:
+            valve_part = (
+                valve_part * (self._factor / factor_before) if factor_before > 0.0 else 0.0
+            )
+        self._replan(t, valve_part + self._leak_N, driven)
+
+    def _retime_pending_openings(self, t_ns: int) -> None:
+        """Give the current opening delay to every coil pulse not yet open at ``t_ns``."""
+        od = self.params.open_delay_ns + self._extra_delay_ns
+        self._past_pulses = [
+            (on, off, od if on + d > t_ns else d, dropped)
+            for on, off, d, dropped in self._past_pulses
+        ]
+        if self._coil_on_ns + self._coil_od_ns > t_ns:
+            self._coil_od_ns = od
+
     def _driven_at(self, t_ns: int) -> bool:
         """Whether the current plan drives the valve open at ``t_ns``."""
-        for t0, _f0, target, _k in reversed(self._segments):
-            if t_ns >= t0:
-                return target > 0.0
+        for t_e, driven in reversed(self._drive_plan):
+            if t_ns >= t_e:
+                return driven
         return False
 
     def _drive_intervals(self, t_ns: int) -> list[tuple[int, int]]:
         """Merged physical drive intervals [a, b) still ending after ``t_ns``."""
-        od = self.params.open_delay_ns
         cd = self.params.close_delay_ns
         self._past_pulses = [p for p in self._past_pulses if p[1] + cd > t_ns]
-        pulses = [*self._past_pulses, (self._coil_on_ns, self._coil_off_ns)]
-        merged: list[tuple[int, int]] = []
-        for on_ns, off_ns in pulses:
+        current = (self._coil_on_ns, self._coil_off_ns, self._coil_od_ns, self._coil_dropped)
+        spans: list[tuple[int, int]] = []
+        for on_ns, off_ns, od, dropped in (*self._past_pulses, current):
             a, b = on_ns + od, off_ns + cd
-            if off_ns <= on_ns or b <= a or b <= t_ns:
+            if dropped or off_ns <= on_ns or b <= a or b <= t_ns:
                 continue
+            spans.append((a, b))
+        spans.sort()  # opening delays may differ between pulses (delayed fault)
+        merged: list[tuple[int, int]] = []
+        for a, b in spans:
             if merged and a <= merged[-1][1]:
                 merged[-1] = (merged[-1][0], max(merged[-1][1], b))
             else:
@@ -342,9 +582,9 @@ class Valve:
             else:
                 edges.append((a, True))
             edges.append((b, False))
-        if self.fault == FAULT_STUCK_CLOSED:
+        if self._stuck == FAULT_STUCK_CLOSED:
             drive_now, edges = False, []
-        elif self.fault == FAULT_STUCK_OPEN:
+        elif self._stuck == FAULT_STUCK_OPEN:
             drive_now = drive_now or driven_before
             edges = [] if drive_now else [e for e in edges if e[1]][:1]
 
@@ -357,17 +597,25 @@ class Valve:
                 first = i
                 break
         segs = [s for s in old[first:] if s[0] < t_ns]
-        fmax, kr, kt = prm.max_thrust_N, prm.inv_rise_tau_per_ns, prm.inv_tail_tau_per_ns
-        seg: _Segment = (t_ns, f_now, fmax, kr) if drive_now else (t_ns, f_now, 0.0, kt)
+        kr, kt = prm.inv_rise_tau_per_ns, prm.inv_tail_tau_per_ns
+        # Driven: rise towards factor·Fmax + leak (a factor of 0 is never driven open);
+        # undriven: decay towards the leak.
+        leak = self._leak_N
+        drive_target = self._factor * prm.max_thrust_N + leak
+        drive_k = kr if self._factor > 0.0 else kt
+        seg: _Segment = (
+            (t_ns, f_now, drive_target, drive_k) if drive_now else (t_ns, f_now, leak, kt)
+        )
         segs.append(seg)
         for t_e, rising in edges:
             t0, f0, target, k = seg
             f_e = target + (f0 - target) * math.exp((t0 - t_e) * k)
             if target == 0.0 and f_e <= prm.cutoff_N:
                 f_e = 0.0
-            seg = (t_e, f_e, fmax, kr) if rising else (t_e, f_e, 0.0, kt)
+            seg = (t_e, f_e, drive_target, drive_k) if rising else (t_e, f_e, leak, kt)
             segs.append(seg)
         self._segments = segs
+        self._drive_plan = [(t_ns, drive_now), *edges]
         self._last_event_ns = t_ns
 
         t0, f0, target, _k = seg
