@@ -31,6 +31,7 @@ import numpy as np
 from cantools.database.can import Database
 
 from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_time_ns
+from bench.faults import BUS_KINDS, FaultSpec
 from bench.metrics import expectation, latency_summary, pointing_metrics
 from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder
@@ -40,6 +41,8 @@ from dbc.errors import RunError
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 
 WATCHDOG_PERIODS = 3
+FAULT_RNG_STREAM = 0xFA  # spawn key of the fault-injection random stream
+BENCH_NODE = "BENCH"
 STARTUP_POLL_S = 0.2
 SILENT_AFTER_STALLS = 3
 THRUSTERS_PER_CMD_FRAME = 4
@@ -171,8 +174,9 @@ class BenchNode:
         self.fsw_est_err_deg = float("nan")
         self.faults_log: list[dict[str, Any]] = []
         self.pending_faults = list(sc.faults)
-        self.active_faults: dict[int, str] = {}
-        self.fault_clears: list[tuple[int, int]] = []
+        self.active_faults: list[tuple[FaultSpec, int | None]] = []
+        self.fault_rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
+        self.sender_of = {m.name: (m.senders[0] if m.senders else "") for m in db.messages}
         self.on_time_last = [0.0] * self.n_thr
         self.tel_t: list[float] = []
         self.tel_err: list[float] = []
@@ -273,26 +277,41 @@ class BenchNode:
 
     # -- faults and watchdog -----------------------------------------------------
     def _faults_due(self, t_ns: int) -> None:
+        """Start the scheduled faults due at ``t_ns`` and end the expired ones."""
         while self.pending_faults and self.pending_faults[0].t_s * NS_PER_S <= t_ns:
             f = self.pending_faults.pop(0)
-            self.plant.thrusters.set_fault(f.thruster, f.kind)
-            self.active_faults[f.thruster] = f.kind
-            rec = {
-                "t_s": t_ns / NS_PER_S,
-                "kind": f.kind,
-                "thruster": f.thruster,
-                "duration_s": f.duration_s,
-                "source": "scenario",
-            }
-            self.faults_log.append(rec)
-            self.trace.event(t_ns, "fault_injected", **rec)
-            if f.duration_s > 0:
-                self.fault_clears.append((t_ns + round(f.duration_s * NS_PER_S), f.thruster))
-        for clear in [c for c in self.fault_clears if c[0] <= t_ns]:
-            self.fault_clears.remove(clear)
-            self.plant.thrusters.set_fault(clear[1], None)
-            self.active_faults.pop(clear[1], None)
-            self.trace.event(t_ns, "fault_cleared", thruster=clear[1])
+            end = t_ns + round(f.duration_s * NS_PER_S) if f.duration_s > 0 else None
+            self._start_fault(f, t_ns, end)
+        for item in [x for x in self.active_faults if x[1] is not None and x[1] <= t_ns]:
+            self.active_faults.remove(item)
+            f = item[0]
+            if f.thruster is not None:
+                self.plant.thrusters.set_fault(f.thruster, None, t_ns)
+            self.trace.event(t_ns, "fault_cleared", **f.record())
+
+    def _start_fault(self, f: FaultSpec, t_ns: int, end_ns: int | None) -> None:
+        rec = {**f.record(), "t_s": t_ns / NS_PER_S, "source": "scenario"}
+        if f.kind in BUS_KINDS and self.mode != "lockstep":
+            rec["applied"] = False
+            rec["why"] = "bus faults act on the modelled bus (lockstep runs only)"
+        elif f.thruster is not None:
+            self.plant.thrusters.set_fault(f.thruster, f.kind, t_ns)
+        elif f.kind == "bus_off" and f.node is not None:
+            until = self.arbiter.bus_off(f.node, t_ns, end_ns)
+            rec["until_s"] = until / NS_PER_S
+            end_ns = until
+        self.active_faults.append((f, end_ns))
+        self.faults_log.append(rec)
+        self.trace.event(t_ns, "fault_injected", **rec)
+
+    def _failed_attempts(self, name: str) -> int:
+        """Link errors drawn for one frame of ``name`` (0 or 1) from the active faults."""
+        for f, _ in self.active_faults:
+            if f.kind == "link_error" and (
+                f.message == name or (f.node is not None and f.node == self.sender_of[name])
+            ) and self.fault_rng.random() < f.params["probability"]:
+                return 1
+        return 0
 
     def _watchdog(self, t_ns: int) -> None:
         if (
@@ -315,8 +334,9 @@ class BenchNode:
         nxt = (t_ns // self.tick_ns + 1) * self.tick_ns
         if self.pending_faults:
             nxt = min(nxt, _step_ceil(round(self.pending_faults[0].t_s * NS_PER_S)))
-        for t_clear, _ in self.fault_clears:
-            nxt = min(nxt, _step_ceil(t_clear))
+        for _, t_end in self.active_faults:
+            if t_end is not None:
+                nxt = min(nxt, _step_ceil(t_end))
         if not self.watchdog_tripped:
             nxt = min(
                 nxt,
@@ -362,7 +382,8 @@ class BenchNode:
                              bits=frame_bits(msg.arbitration_id, bytes(msg.data)))
         else:
             bits = frame_bits(msg.arbitration_id, bytes(msg.data))
-            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits)
+            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits, node=BENCH_NODE,
+                                      failed_attempts=self._failed_attempts(name))
             self._wire_pending[seq] = (msg, True, bits)
         if name == "IMU_RATE":
             self.imu_tx_ns[msg.data[1] & 0x0F] = ready_ns if realtime_ns is None else realtime_ns
@@ -491,7 +512,9 @@ class BenchNode:
             if d is None:
                 continue
             bits = frame_bits(msg.arbitration_id, bytes(msg.data))
-            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits)
+            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits,
+                                      node=self.sender_of[d.name],
+                                      failed_attempts=self._failed_attempts(d.name))
             self._wire_pending[seq] = (msg, False, bits)
             s: dict[str, float] = d.signals
             if d.name.startswith("THR_CMD_"):

@@ -8,7 +8,7 @@ off). A test asks for ``hil_run`` and calls it::
         run = hil_run("scenarios/quickstart.toml", duration_s=5)
         assert run.latency("IMU_RATE", "THR_CMD_0").p99_us < 2000
 
-``hil_run(scenario, *, mode, bus, seed, duration_s, fsw_cmd, timing, fresh)`` starts the
+``hil_run(scenario, *, mode, bus, seed, duration_s, fsw_cmd, overrides, timing, fresh)`` starts the
 bench and the flight software through :func:`bench.orchestrator.run_scenario` (the bench
 in the test process, the flight software as its own process, exactly as
 ``thruster-hil run`` does) in a fresh run folder under pytest's temporary directory, and
@@ -41,7 +41,7 @@ from __future__ import annotations
 import math
 import os
 import uuid
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
@@ -145,6 +145,7 @@ class HilRunOptions:
     seed: int | None = None
     duration_s: float | None = None
     fsw_cmd: str | None = None  # None: the bench alone
+    overrides: tuple[str, ...] = ()  # scenario KEY=VALUE overrides, e.g. bus.bitrate_bps=125000
 
     def __post_init__(self) -> None:
         if not isinstance(self.scenario, Path) or not self.scenario.is_file():
@@ -170,6 +171,10 @@ class HilRunOptions:
             raise _bad("duration_s", d, "None or a finite number of seconds > 0")
         if self.fsw_cmd is not None and (not isinstance(self.fsw_cmd, str) or not self.fsw_cmd):
             raise _bad("fsw_cmd", self.fsw_cmd, "None or a command line")
+        if not isinstance(self.overrides, tuple) or not all(
+            isinstance(o, str) and "=" in o for o in self.overrides
+        ):
+            raise _bad("overrides", self.overrides, "KEY=VALUE strings")
 
 
 class HilRun:
@@ -286,6 +291,7 @@ class HilRunner:
         seed: int | None = None,
         duration_s: float | None = None,
         fsw_cmd: str | None = UNSET,
+        overrides: Sequence[str] = (),
         timing: TimingOptions | None = None,
         fresh: bool = False,
     ) -> HilRun:
@@ -294,6 +300,7 @@ class HilRunner:
         ``mode``/``bus``: override ``--hil-mode``/``--hil-bus``; ``seed``/``duration_s``:
         override the scenario's; ``fsw_cmd``: the flight-software command (None: the
         bench alone; default ``--hil-fsw-cmd`` or this project's flight software);
+        ``overrides``: scenario ``KEY=VALUE`` overrides (``"bus.bitrate_bps=125000"``);
         ``timing``: :class:`~bench.analysis.timing.TimingOptions` for the measurements;
         ``fresh``: do not reuse an identical lockstep run of this session.
         """
@@ -310,6 +317,7 @@ class HilRunner:
             seed=seed,
             duration_s=duration_s,
             fsw_cmd=fsw_cmd,
+            overrides=(overrides,) if isinstance(overrides, str) else tuple(overrides),
         )
         s = self._session
         if opts.mode != "lockstep" or fresh or opts not in s.runs:
@@ -328,7 +336,7 @@ class HilRunner:
         from bench.orchestrator import RunOptions, run_scenario
         from bench.scenario import load_scenario
 
-        sc = load_scenario(opts.scenario)
+        sc = load_scenario(opts.scenario, list(opts.overrides))
         private = opts.bus is None
         bus = (
             f"hilbus:{PRIVATE_CHANNEL_PREFIX}{uuid.uuid4().hex[:PRIVATE_CHANNEL_HEX]}"

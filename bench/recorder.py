@@ -74,7 +74,7 @@ class TraceRecorder:
 
     def event(self, t_ns: int, what: str, /, **fields: Any) -> None:
         """Append one event line (``what`` at ``t_ns`` with ``fields``) and flush it."""
-        self._events.write(json.dumps({"t_s": t_ns / NS_PER_S, "event": what, **fields}) + "\n")
+        self._events.write(json.dumps({"event": what, **fields, "t_s": t_ns / NS_PER_S}) + "\n")
         self._events.flush()
 
     def flush(self) -> None:

@@ -19,7 +19,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from bench.faults import FaultSpec, parse_faults
 from bench.valves.layouts import LAYOUTS
+from dbc import load_database
 from dbc.errors import ConfigError
 from dbc.schema import Table
 
@@ -31,7 +33,6 @@ else:  # pragma: no cover
 DEG_RAD = math.pi / 180.0
 SQRT_HOUR_S = 60.0  # sqrt(3600 s)
 UNIT_NORM_TOL = 1e-6
-FAULT_KINDS = ("stuck_closed", "stuck_open")
 MODES = ("lockstep", "realtime")
 
 Vec3 = tuple[float, float, float]
@@ -91,14 +92,6 @@ class BusSpecCfg:
     fsw_response_delay_s: float
     stall_timeout_s: float
     startup_timeout_s: float
-
-
-@dataclass(frozen=True)
-class FaultSpec:
-    t_s: float
-    kind: str
-    thruster: int
-    duration_s: float  # 0 = permanent
 
 
 @dataclass(frozen=True)
@@ -269,22 +262,6 @@ def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec]:
     return gyro, accel, st
 
 
-def _faults(tables: list[Table], duration_s: float, n_thr: int) -> tuple[FaultSpec, ...]:
-    out = []
-    for f in tables:
-        spec = FaultSpec(
-            t_s=f.number("t_s", lo=0.0, hi=duration_s),
-            kind=f.string("kind", choices=FAULT_KINDS),
-            thruster=f.integer("thruster", lo=0),
-            duration_s=f.number("duration_s", 0.0, lo=0.0),
-        )
-        if spec.thruster >= n_thr:
-            raise f.error("thruster", spec.thruster, f"a thruster index 0..{n_thr - 1}")
-        f.done()
-        out.append(spec)
-    return tuple(sorted(out, key=lambda x: x.t_s))
-
-
 def _opt(t: Table, key: str) -> float | None:
     return t.number(key, lo=0.0) if t.has(key) else None
 
@@ -338,7 +315,11 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     if not isinstance(fsw, dict):
         raise root.error("flight_sw", fsw, "a table")
 
-    faults = _faults(root.tables("faults"), duration_s, len(thrusters))
+    db = load_database()
+    faults = parse_faults(
+        root.tables("faults"), duration_s, len(thrusters),
+        frozenset(m.name for m in db.messages), frozenset(n.name for n in db.nodes),
+    )
 
     et = root.table("expectations", {})
     exp = Expectations(

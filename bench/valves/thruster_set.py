@@ -26,10 +26,30 @@ Bookkeeping (why it matches the plant exactly)
     Callers that sample the thrusters themselves (e.g. to add disturbances) can use
     ``thrusts_N`` and ``accumulate`` instead.
 
+Faults (``set_fault(index, kind, t_ns, **params)`` / ``clear_fault(index, kind, t_ns)``)
+    Every valve fault of :mod:`bench.valves.valve` (``stuck_closed``, ``stuck_open``,
+    ``degraded``, ``delayed``, ``intermittent``, ``leak``; parameters and timing there)
+    is routed to the thruster's valve, and the thrust it changes is booked like any
+    other (a leak's impulse and propellant included). The thruster set adds:
+    - ``"misaligned"``, ``angle_deg`` [deg] in [−180, 180] and ``axis_B`` (unit vector,
+      body axes [-]): the thrust direction is rotated by the angle about the axis
+      (right hand), d' = R(axis, angle) d (Rodrigues' rotation formula, applied through
+      the quaternion ``quat_from_axis_angle``), so both the force row d' and the torque
+      row r × d' of that thruster change; models a bent nozzle or a shifted mount. A
+      geometry change has no time history: it applies to every wrench evaluated after
+      the call (call it at the step boundary ``t_ns``); setting it again replaces the
+      angle and axis (it does not compound).
+    ``set_fault(index, None, t_ns)`` clears every fault of that thruster. Inactive faults
+    cost nothing per step: the valve folds its faults into its thrust segments and a
+    misalignment into the precomputed rows of the wrench sum.
+    ``rng`` (constructor, optional) seeds one independent generator per valve for the
+    ``intermittent`` drop-outs, so a fault on one thruster never shifts another's draws.
+
 Assumptions
     Thrusters are independent (no manifold pressure coupling), geometry is fixed in the
-    body, thrust acts along ``d_thr_B`` through ``r_thr_B_m``. Dispersion and misalignment
-    (DESIGN.md §6) are expressed by the caller through the geometry and parameters given.
+    body (apart from a ``misaligned`` fault), thrust acts along the direction through
+    ``r_thr_B_m``. Dispersion of the nominal parameters (DESIGN.md §6) is expressed by
+    the caller through the geometry and parameters given.
 """
 
 from __future__ import annotations
@@ -38,8 +58,10 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from bench.dynamics.rigid_body import Vec3, Wrench
-from bench.valves.valve import S_PER_NS, Valve, ValveParams
+import numpy as np
+
+from bench.dynamics.rigid_body import Vec3, Wrench, quat_from_axis_angle, rotate_B_to_N
+from bench.valves.valve import FAULT_KINDS, S_PER_NS, FaultParams, Valve, ValveParams
 from dbc.errors import ConfigError
 
 G0_M_S2 = 9.80665
@@ -49,6 +71,14 @@ UNIT_NORM_TOL = 1e-6
 VEC3_LEN = 3
 SIMPSON_MID_WEIGHT = 4.0
 SIMPSON_DIVISOR = 6.0
+FAULT_MISALIGNED = "misaligned"
+THRUSTER_FAULT_KINDS = FAULT_KINDS | {FAULT_MISALIGNED}
+"""Every fault kind ``ThrusterSet.set_fault`` accepts."""
+MISALIGNED_PARAMS = ("angle_deg", "axis_B")
+MAX_MISALIGNMENT_DEG = 180.0
+"""|angle_deg| of a ``misaligned`` fault is at most this (any rotation is reachable)."""
+CHILD_SEED_BOUND = 2**63 - 1
+"""Exclusive upper bound of the per-valve seeds drawn from the constructor's ``rng``."""
 
 ThrusterStatus = tuple[bool, bool, bool]
 """(coil_energised, open, current) of one valve, as ``Valve.status``."""
@@ -100,9 +130,18 @@ class ThrusterSet:
 
     ``params`` is one ``ValveParams`` shared by all thrusters or a sequence of one per
     thruster. ``g0_m_s2`` is the Isp reference gravity (standard gravity by default).
+    ``rng`` (optional) seeds each valve's generator for ``intermittent`` drop-outs.
     """
 
-    __slots__ = ("_impulse_Ns", "_rows", "g0_m_s2", "geometries", "valves")
+    __slots__ = (
+        "_impulse_Ns",
+        "_misalignment",
+        "_rows",
+        "_source",
+        "g0_m_s2",
+        "geometries",
+        "valves",
+    )
 
     def __init__(
         self,
@@ -111,6 +150,7 @@ class ThrusterSet:
         g0_m_s2: float = G0_M_S2,
         *,
         source: str = "ThrusterSet",
+        rng: np.random.Generator | None = None,
     ) -> None:
         geoms = tuple(geometries)
         if not geoms or not all(isinstance(g, ThrusterGeometry) for g in geoms):
@@ -128,14 +168,28 @@ class ThrusterSet:
                 )
         if isinstance(g0_m_s2, bool) or not (math.isfinite(g0_m_s2) and g0_m_s2 > 0.0):
             raise ConfigError(source, "g0_m_s2", g0_m_s2, "a finite number > 0")
+        if rng is None:
+            rngs: list[np.random.Generator | None] = [None] * len(geoms)
+        elif isinstance(rng, np.random.Generator):
+            seeds = rng.integers(0, CHILD_SEED_BOUND, size=len(geoms)).tolist()
+            rngs = [np.random.default_rng(s) for s in seeds]
+        else:
+            raise ConfigError(source, "rng", rng, "None or a numpy Generator")
+        self._source = source
         self.geometries = geoms
-        self.valves = tuple(Valve(p) for p in plist)
+        self.valves = tuple(Valve(p, r) for p, r in zip(plist, rngs, strict=True))
         self.g0_m_s2 = float(g0_m_s2)
         self._impulse_Ns = [0.0] * len(geoms)
-        # Hot-path rows: (index, valve, dx, dy, dz, (r×d)x, (r×d)y, (r×d)z)
+        # Active misalignments: index → (recorded parameters, rotated geometry).
+        self._misalignment: dict[int, tuple[FaultParams, ThrusterGeometry]] = {}
+        self._rows: tuple[tuple[int, Valve, float, float, float, float, float, float], ...] = ()
+        self._build_rows()
+
+    def _build_rows(self) -> None:
+        """Hot-path rows: (index, valve, dx, dy, dz, (r×d)x, (r×d)y, (r×d)z), faults applied."""
         self._rows = tuple(
             (i, v, *g.d_thr_B, *g.torque_arm_B_m)
-            for i, (v, g) in enumerate(zip(self.valves, geoms, strict=True))
+            for i, (v, g) in enumerate(zip(self.valves, self.effective_geometries, strict=True))
         )
 
     def __len__(self) -> int:
@@ -151,9 +205,114 @@ class ThrusterSet:
         for v in self.valves:
             v.command(t_ns, 0)
 
-    def set_fault(self, index: int, kind: str | None, t_ns: int | None = None) -> None:
-        """Inject or clear a fault on valve ``index`` (see ``Valve.set_fault``)."""
-        self.valves[index].set_fault(kind, t_ns)
+    def set_fault(
+        self, index: int, kind: str | None, t_ns: int | None = None, **params: object
+    ) -> None:
+        """Inject fault ``kind`` with ``params`` on thruster ``index`` at ``t_ns``, or clear all.
+
+        Valve kinds go to ``Valve.set_fault`` (same ``t_ns`` default and parameters);
+        ``"misaligned"`` takes ``angle_deg`` and ``axis_B`` (module docstring). ``None``
+        clears every fault of the thruster. Bad index, kind or parameters: ``ConfigError``.
+        """
+        i = self._check_index(index, kind)
+        if kind is None:
+            self.valves[i].set_fault(None, t_ns, **params)
+            if self._misalignment.pop(i, None) is not None:
+                self._build_rows()
+        elif kind == FAULT_MISALIGNED:
+            self._misalignment[i] = self._misaligned(i, params)
+            self._build_rows()
+        else:
+            self.valves[i].set_fault(kind, t_ns, **params)
+
+    def clear_fault(self, index: int, kind: str, t_ns: int | None = None) -> None:
+        """Clear fault ``kind`` of thruster ``index`` at ``t_ns``; a no-op if it is inactive."""
+        i = self._check_index(index, kind)
+        if kind == FAULT_MISALIGNED:
+            if self._misalignment.pop(i, None) is not None:
+                self._build_rows()
+        else:
+            self.valves[i].clear_fault(kind, t_ns)
+
+    @property
+    def faults_active(self) -> dict[int, dict[str, FaultParams]]:
+        """Active faults of the faulty thrusters: index → kind → recorded parameters."""
+        out: dict[int, dict[str, FaultParams]] = {}
+        for i, v in enumerate(self.valves):
+            faults = v.faults_active
+            if i in self._misalignment:
+                faults[FAULT_MISALIGNED] = dict(self._misalignment[i][0])
+            if faults:
+                out[i] = faults
+        return out
+
+    @property
+    def effective_geometries(self) -> tuple[ThrusterGeometry, ...]:
+        """Geometry per thruster as the wrench uses it (nominal unless ``misaligned``)."""
+        mis = self._misalignment
+        return tuple(mis[i][1] if i in mis else g for i, g in enumerate(self.geometries))
+
+    @property
+    def dropped_pulses(self) -> tuple[int, ...]:
+        """Coil pulses dropped by ``intermittent`` faults so far, per thruster."""
+        return tuple(v.dropped_pulses for v in self.valves)
+
+    def _check_index(self, index: int, kind: str | None) -> int:
+        n = len(self.valves)
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < n:
+            raise ConfigError(
+                f"{self._source}.set_fault({kind!r})", "index", index, f"an integer in [0, {n})"
+            )
+        if kind is not None and kind not in THRUSTER_FAULT_KINDS:
+            raise ConfigError(
+                f"{self._source}.set_fault({kind!r})",
+                "kind",
+                kind,
+                f"None or one of {sorted(THRUSTER_FAULT_KINDS)}",
+            )
+        return index
+
+    def _misaligned(
+        self, index: int, params: dict[str, object]
+    ) -> tuple[FaultParams, ThrusterGeometry]:
+        """Validated ``misaligned`` parameters and the rotated geometry of ``index``."""
+        source = f"{self._source}.set_fault({FAULT_MISALIGNED!r})"
+        for key, value in params.items():
+            if key not in MISALIGNED_PARAMS:
+                raise ConfigError(
+                    source, key, value, f"no such parameter (expected {list(MISALIGNED_PARAMS)})"
+                )
+        for key in MISALIGNED_PARAMS:
+            if key not in params:
+                raise ConfigError(source, key, None, f"a value (required by {FAULT_MISALIGNED!r})")
+        angle = params["angle_deg"]
+        if (
+            isinstance(angle, bool)
+            or not isinstance(angle, (int, float))
+            or not (math.isfinite(angle) and abs(angle) <= MAX_MISALIGNMENT_DEG)
+        ):
+            raise ConfigError(
+                source,
+                "angle_deg",
+                angle,
+                f"a number in [-{MAX_MISALIGNMENT_DEG:g}, {MAX_MISALIGNMENT_DEG:g}]",
+            )
+        axis = _vec3(params["axis_B"], source, "axis_B")
+        if not abs(math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2) - 1.0) <= UNIT_NORM_TOL:
+            raise ConfigError(
+                source,
+                "axis_B",
+                params["axis_B"],
+                f"a unit vector (|norm - 1| <= {UNIT_NORM_TOL:g})",
+            )
+        nominal = self.geometries[index]
+        d = rotate_B_to_N(quat_from_axis_angle(axis, math.radians(angle)), nominal.d_thr_B)
+        # Renormalise away round-off so the geometry stays a unit direction.
+        n = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        rotated = ThrusterGeometry(
+            nominal.r_thr_B_m, (d[0] / n, d[1] / n, d[2] / n), source=nominal.source
+        )
+        return {"angle_deg": float(angle), "axis_B": axis}, rotated
 
     # --- the plant's inputs ---------------------------------------------------------
     def wrench_B(self, t_ns: int) -> Wrench:

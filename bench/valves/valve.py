@@ -127,8 +127,10 @@ FAULT_OPTIONAL_PARAMS: Mapping[str, tuple[str, ...]] = {FAULT_INTERMITTENT: ("rn
 FAULT_KINDS = frozenset(FAULT_PARAMS)
 _STUCK_KINDS = frozenset({FAULT_STUCK_CLOSED, FAULT_STUCK_OPEN})
 NOMINAL_THRUST_FACTOR = 1.0
-FaultParams = dict[str, float]
-"""Recorded parameters of one active fault: name → value in the units of its name."""
+FaultParams = dict[str, float | tuple[float, ...]]
+"""Recorded parameters of one active fault: name → value (number or vector) in the units
+of its name (a copy, safe to log; generators are not recorded)."""
+_ValveFaultParams = dict[str, float]
 
 # A thrust segment: (t_start_ns, thrust at t_start [N], target thrust [N], 1/τ [1/ns]).
 _Segment = tuple[int, float, float, float]
@@ -147,14 +149,20 @@ def _fault_number(
     source: str, key: str, value: object, lo: float, hi: float, expected: str = ""
 ) -> float:
     """``value`` as a finite float in [lo, hi], or ConfigError naming ``key``."""
-    ok = _is_real(value) and math.isfinite(value) and lo <= value <= hi  # type: ignore[arg-type]
-    _require(ok, source, key, value, expected or f"a number in [{lo:g}, {hi:g}]")
-    return float(value)  # type: ignore[arg-type]
+    x = float(value) if _is_real(value) else math.nan  # type: ignore[arg-type]
+    _require(
+        math.isfinite(x) and lo <= x <= hi,
+        source,
+        key,
+        value,
+        expected or f"a number in [{lo:g}, {hi:g}]",
+    )
+    return x
 
 
 def check_fault_params(
     kind: str, params: Mapping[str, object], source: str, max_thrust_N: float
-) -> FaultParams:
+) -> _ValveFaultParams:
     """Validate the parameters of a valve fault ``kind``; returns the recorded ones.
 
     Unknown or missing names and out-of-range values raise ``ConfigError(source, name,
@@ -177,7 +185,7 @@ def check_fault_params(
     if "rng" in params:
         rng = params["rng"]
         _require(isinstance(rng, np.random.Generator), source, "rng", rng, "a numpy Generator")
-    out: FaultParams = {}
+    out: _ValveFaultParams = {}
     if kind == FAULT_DEGRADED:
         out["factor"] = _fault_number(source, "factor", params["factor"], 0.0, 1.0)
     elif kind == FAULT_DELAYED:
@@ -260,8 +268,8 @@ class Valve:
 
     __slots__ = (
         "_coil_dropped",
-        "_coil_off_ns",
         "_coil_od_ns",
+        "_coil_off_ns",
         "_coil_on_ns",
         "_drive_plan",
         "_dropout_p",
@@ -305,7 +313,7 @@ class Valve:
         self._drive_plan: list[tuple[int, bool]] = [(-NEVER_NS, False)]
         # Faults: recorded parameters by kind (insertion order = order set) and their
         # effect on the model, nominal values when none is active.
-        self._faults: dict[str, FaultParams] = {}
+        self._faults: dict[str, _ValveFaultParams] = {}
         self._stuck: str | None = None
         self._factor = NOMINAL_THRUST_FACTOR
         self._extra_delay_ns = 0
@@ -425,7 +433,7 @@ class Valve:
             dropped = False
             if self._dropout_rng is not None:  # intermittent: one draw per coil pulse
                 dropped = float(self._dropout_rng.random()) < self._dropout_p
-                self.dropped_pulses += dropped
+                self.dropped_pulses += int(dropped)
             self._coil_dropped = dropped
             self.openings += 1
         self._replan(t_ns, f_now, driven)
@@ -489,7 +497,7 @@ class Valve:
     def _event(
         self,
         t_ns: int | None,
-        changes: Mapping[str, FaultParams | None],
+        changes: Mapping[str, _ValveFaultParams | None],
         rng: np.random.Generator | None = None,
     ) -> None:
         """Apply fault changes (kind → new parameters, None = clear) at ``t_ns`` and replan.
@@ -511,7 +519,9 @@ class Valve:
                     faults.pop(FAULT_STUCK_CLOSED, None)
                 faults[kind] = recorded
         self._stuck = next((k for k in faults if k in _STUCK_KINDS), None)
-        self._factor = faults[FAULT_DEGRADED]["factor"] if FAULT_DEGRADED in faults else 1.0
+        self._factor = (
+            faults[FAULT_DEGRADED]["factor"] if FAULT_DEGRADED in faults else NOMINAL_THRUST_FACTOR
+        )
         self._leak_N = faults[FAULT_LEAK]["thrust_N"] if FAULT_LEAK in faults else 0.0
         extra_s = faults[FAULT_DELAYED]["extra_delay_s"] if FAULT_DELAYED in faults else 0.0
         extra_ns = round(extra_s * NS_PER_S)
@@ -529,9 +539,7 @@ class Valve:
                 self._coil_dropped = False  # the pulse in progress may now open
         valve_part = max(0.0, f_now - leak_before)
         if self._factor != factor_before:
-            valve_part = (
-                valve_part * (self._factor / factor_before) if factor_before > 0.0 else 0.0
-            )
+            valve_part = valve_part * (self._factor / factor_before) if factor_before > 0.0 else 0.0
         self._replan(t, valve_part + self._leak_N, driven)
 
     def _retime_pending_openings(self, t_ns: int) -> None:

@@ -365,6 +365,6 @@ def test_unknown_fault_kind_is_rejected() -> None:
     """An unknown fault kind is a ConfigError naming 'kind' and the value."""
     v = Valve(_params())
     with pytest.raises(ConfigError) as exc:
-        v.set_fault("leak")
+        v.set_fault("sticky")
     assert exc.value.key == "kind"
-    assert exc.value.value == "leak"
+    assert exc.value.value == "sticky"

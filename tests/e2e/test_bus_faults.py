@@ -1,0 +1,71 @@
+"""Link errors and bus-off on the modelled bus: command latency grows by what the model predicts."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from bench.bus.timing import bus_off_recovery_ns, failed_attempt_bits, wire_time_ns
+from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
+
+pytestmark = pytest.mark.slow
+
+BITRATE_BPS = 1_000_000
+PERIOD_S = 0.02
+ERR_FROM_S, ERR_TO_S = 1.0, 2.0
+BUS_OFF_S = 2.5
+DURATION_S = "4"
+TOL_US = 0.5  # rounding of modelled times to the microsecond in frames.csv/chains.csv
+THR_CMD_BITS_MAX = 135
+STUFFING_TOL_US = 10.0  # a few stuff bits per frame on the path at 1 us/bit  # 8-byte frame, worst-case stuffing
+
+
+def _latencies_us(out: Path) -> dict[int, float]:
+    with open(out / "chains.csv", newline="") as f:
+        return {
+            int(r["cycle"]): (float(r["t_cmd_rx_s"]) - float(r["t_imu_tx_s"])) * 1e6
+            for r in csv.DictReader(f)
+        }
+
+
+def test_link_errors_and_bus_off_delay_commands_as_modelled(
+    tmp_path: Path, runtime_dir: Path
+) -> None:
+    """A failed attempt costs frame + error frame; bus-off holds the node for 1408 bit times."""
+    sc = tmp_path / "faults.toml"
+    sc.write_text(
+        QUICKSTART.read_text()
+        + f"\n[[faults]]\nt_s = {ERR_FROM_S}\nduration_s = {ERR_TO_S - ERR_FROM_S}\n"
+        'kind = "link_error"\nmessage = "THR_CMD_1"\nprobability = 1.0\n'
+        f'\n[[faults]]\nt_s = {BUS_OFF_S}\nkind = "bus_off"\nnode = "FSW"\n'
+    )
+    ref = run_cli(
+        ["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", DURATION_S],
+        tmp_path / "ref",
+        runtime_dir,
+    )
+    run = run_cli(
+        ["run", str(sc), "--bus", unique_bus(), "--duration", DURATION_S],
+        tmp_path / "faults",
+        runtime_dir,
+    )
+    base, lat = _latencies_us(ref.out), _latencies_us(run.out)
+    err_cycles = range(round(ERR_FROM_S / PERIOD_S), round(ERR_TO_S / PERIOD_S))
+    for k in err_cycles:
+        extra = lat[k] - base[k]
+        # THR_CMD_1 (last command frame) fails once: the bits sent until the error plus the
+        # error frame and intermission, between the lower and upper frame lengths
+        lo = wire_time_ns(failed_attempt_bits(100).nominal_bits, BITRATE_BPS) / 1e3
+        hi = wire_time_ns(failed_attempt_bits(THR_CMD_BITS_MAX).nominal_bits, BITRATE_BPS) / 1e3
+        assert lo - TOL_US <= extra <= hi + TOL_US, (k, extra)
+    k_off = round(BUS_OFF_S / PERIOD_S)
+    ready_after_off_us = 1000.0  # the FSW's frames are queued 1 ms after SYNC, inside the window
+    expected = bus_off_recovery_ns(BITRATE_BPS) / 1e3 - ready_after_off_us
+    assert lat[k_off] - base[k_off] == pytest.approx(expected, abs=5.0)
+    # elsewhere only stuffing differs (the trajectory, hence the payloads, diverge slightly)
+    for k in set(base) - set(err_cycles) - {k_off}:
+        assert lat[k] == pytest.approx(base[k], abs=STUFFING_TOL_US), k
+    faults = run.summary["faults"]
+    assert [f["kind"] for f in faults] == ["link_error", "bus_off"]
