@@ -50,10 +50,13 @@ CYCLE_MODULUS = 256
 NS_PER_S = 1_000_000_000
 RAD_DEG = 180.0 / math.pi
 TELEMETRY_PERIOD_NS = 10_000_000
-SENSOR_ORDER = ("IMU_RATE", "IMU_ACCEL", "STR_QUAT", "THR_STATUS", "BENCH_STATUS")
+SENSOR_ORDER = ("IMU_RATE", "IMU_ACCEL", "STR_QUAT", "NAV_POS", "NAV_VEL", "THR_STATUS",
+                "BENCH_STATUS")
 FSW_FRAMES = frozenset(
     {"THR_CMD_0", "THR_CMD_1", "THR_CMD_2", "THR_CMD_3", "FSW_STATUS", "FSW_ATT_EST", "FAULT_CMD"}
 )
+NAV_POS_MAX_M = 32.767  # NAV_POS range in the DBC
+NAV_VEL_MAX_M_S = 3.2767  # NAV_VEL range in the DBC
 HEALTH_WATCHDOG = 0x1
 HEALTH_FSW_SILENT = 0x2
 
@@ -62,6 +65,11 @@ def quat_error_deg(q: tuple[float, ...] | np.ndarray, r: tuple[float, ...]) -> f
     """Rotation angle between attitudes q and r [deg]."""
     d = abs(q[0] * r[0] + q[1] * r[1] + q[2] * r[2] + q[3] * r[3])
     return 2.0 * math.acos(min(1.0, d)) * RAD_DEG
+
+
+def _clip(x: float, limit: float) -> float:
+    """``x`` limited to the DBC range +-``limit`` (a sensor saturates, it does not wrap)."""
+    return min(limit, max(-limit, x))
 
 
 def _step_ceil(t_ns: int) -> int:
@@ -143,6 +151,10 @@ class BenchNode:
         self.checker = FrameChecker(db, accept=FSW_FRAMES)
         self.period_ns = cycle_time_ns(db, "THR_CMD_0")
         self.sensor_period_ns = {n: cycle_time_ns(db, n) for n in SENSOR_ORDER}
+        self.sensors_sent = tuple(
+            n for n in SENSOR_ORDER if sc.rel_nav is not None or not n.startswith("NAV_")
+        )
+        self._nav_vel: tuple[tuple[float, float, float], bool] = ((0.0, 0.0, 0.0), False)
         self.tick_ns = math.gcd(TELEMETRY_PERIOD_NS, *self.sensor_period_ns.values())
         self.plant = Plant(sc, seed, self.sensor_period_ns["IMU_RATE"])
         self.n_thr = len(sc.thrusters)
@@ -247,6 +259,16 @@ class BenchNode:
         if name == "STR_QUAT":
             q, valid = p.star.sample(t_ns, (s[0], s[1], s[2], s[3]))
             return {"Valid": int(valid), **pack_quaternion(q)}
+        if name == "NAV_POS":
+            assert p.rel_nav is not None
+            pos, vel, ok = p.rel_nav.sample(t_ns, (s[7], s[8], s[9]), (s[10], s[11], s[12]))
+            self._nav_vel = (vel, ok)
+            return {"Valid": int(ok), "PosX": _clip(pos[0], NAV_POS_MAX_M),
+                    "PosY": _clip(pos[1], NAV_POS_MAX_M), "PosZ": _clip(pos[2], NAV_POS_MAX_M)}
+        if name == "NAV_VEL":  # sampled with NAV_POS (same solution), sent right after it
+            vel, ok = self._nav_vel
+            return {"Valid": int(ok), "VelX": _clip(vel[0], NAV_VEL_MAX_M_S),
+                    "VelY": _clip(vel[1], NAV_VEL_MAX_M_S), "VelZ": _clip(vel[2], NAV_VEL_MAX_M_S)}
         if name == "THR_STATUS":
             sig: dict[str, float | int] = {}
             for k, (cmd, opn, cur) in enumerate(p.thrusters.status(t_ns)):
@@ -269,7 +291,7 @@ class BenchNode:
         }
 
     def _queue_due(self, t_ns: int) -> None:
-        for name in SENSOR_ORDER:
+        for name in self.sensors_sent:
             if t_ns % self.sensor_period_ns[name] == 0:
                 self.queue.append(
                     (t_ns, self.encoder.frame_id(name), name, self._sample(name, t_ns))

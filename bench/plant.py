@@ -17,6 +17,7 @@ from bench.dynamics.rigid_body import MassProperties, make_state, rk4_step
 from bench.scenario import Scenario
 from bench.sensors.accelerometer import Accelerometer, AccelerometerParams
 from bench.sensors.gyro import Gyro, GyroParams
+from bench.sensors.rel_nav import RelNav, RelNavParams
 from bench.sensors.star_tracker import StarTracker, StarTrackerParams
 from bench.valves.thruster_set import ThrusterGeometry, ThrusterSet
 from bench.valves.valve import ValveParams
@@ -44,8 +45,8 @@ class Plant:
         self.thrusters = ThrusterSet(
             [ThrusterGeometry(t.r_thr_B_m, t.d_thr_B) for t in sc.thrusters], params
         )
-        rng_g, rng_a, rng_s = (
-            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
+        rng_g, rng_a, rng_s, rng_n = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(4)
         )
         g = sc.gyro
         self.gyro = Gyro(
@@ -78,6 +79,10 @@ class Plant:
                 boresight_B=s.boresight_B,
             ),
             rng_s,
+        )
+        self.rel_nav = (
+            RelNav(RelNavParams(sc.rel_nav.noise_pos_m, sc.rel_nav.noise_vel_m_s), rng_n)
+            if sc.rel_nav is not None else None
         )
         self.t_ns = 0
 

@@ -87,6 +87,12 @@ class StarTrackerSpec:
 
 
 @dataclass(frozen=True)
+class RelNavSpec:
+    noise_pos_m: float
+    noise_vel_m_s: float
+
+
+@dataclass(frozen=True)
 class BusSpecCfg:
     bitrate_bps: int
     fsw_response_delay_s: float
@@ -119,6 +125,7 @@ class Scenario:
     gyro: GyroSpec
     accel: AccelSpec
     star_tracker: StarTrackerSpec
+    rel_nav: RelNavSpec | None
     bus: BusSpecCfg
     q0_BN: Quat
     omega0_BN_B_rad_s: Vec3
@@ -230,7 +237,7 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
     return tuple(geo), v
 
 
-def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec]:
+def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec, RelNavSpec | None]:
     g = t.table("gyro")
     gyro = GyroSpec(
         arw_rad_sqrt_s=g.number("arw_deg_sqrt_h", lo=0.0) * DEG_RAD / SQRT_HOUR_S,
@@ -258,8 +265,13 @@ def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec]:
         boresight_B=_unit(s, "boresight_B", 3),  # type: ignore[arg-type]
     )
     s.done()
+    nav = None
+    if t.has("rel_nav"):
+        n = t.table("rel_nav")
+        nav = RelNavSpec(n.number("noise_pos_m", lo=0.0), n.number("noise_vel_m_s", lo=0.0))
+        n.done()
     t.done()
-    return gyro, accel, st
+    return gyro, accel, st, nav
 
 
 def _opt(t: Table, key: str) -> float | None:
@@ -282,7 +294,7 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     vt.done()
 
     thrusters, valve = _thrusters(root.table("thrusters"))
-    gyro, accel, st = _sensors(root.table("sensors"))
+    gyro, accel, st, nav = _sensors(root.table("sensors"))
 
     bt = root.table("bus", {})
     bus = BusSpecCfg(
@@ -346,6 +358,7 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         gyro=gyro,
         accel=accel,
         star_tracker=st,
+        rel_nav=nav,
         bus=bus,
         q0_BN=q0,
         omega0_BN_B_rad_s=w0,  # type: ignore[arg-type]
