@@ -10,6 +10,15 @@ end of the run), a ``kind`` and its target and parameters:
   re-arbitration (bench/bus/timing).
 - ``bus_off`` (``node``): the node's controller goes bus-off; its frames wait for
   ``duration_s`` or, if 0, for the recovery time of 128 x 11 recessive bits.
+- ``drop`` (``message`` or ``node``; ``probability``): the frame never reaches its receiver.
+- ``delay`` (``message`` or ``node``; ``delay_s``, ``probability``): the frame reaches its
+  receiver ``delay_s`` later than the bus would deliver it (a gateway or driver queue).
+- ``corrupt`` (``message`` or ``node``; ``probability``): one payload bit flipped after
+  the sender's E2E protection (a corrupting gateway): the receiver's CRC must catch it.
+- ``duplicate`` (``message`` or ``node``; ``probability``): the frame arrives twice; the
+  copy repeats the alive counter and must be rejected.
+- ``babbling`` (``can_id``, ``rate_hz``): a babbling node floods the bus with random 8-byte
+  frames of that (typically high-priority, unknown) ID at that rate.
 
 Bus faults act on the modelled bus, so in lockstep runs only (a realtime run records them
 as not applicable). Targets are checked against the scenario's thrusters and the DBC's
@@ -24,7 +33,10 @@ from typing import Any
 from dbc.schema import Table
 
 THRUSTER_KINDS = ("stuck_closed", "stuck_open")
-BUS_KINDS = ("link_error", "bus_off")
+FRAME_KINDS = ("link_error", "drop", "delay", "corrupt", "duplicate")
+BUS_KINDS = (*FRAME_KINDS, "bus_off", "babbling")
+MAX_STD_ID = 0x7FF
+MAX_RATE_HZ = 20_000.0  # above a 1 Mbit/s bus's capacity for 8-byte frames
 FAULT_KINDS = THRUSTER_KINDS + BUS_KINDS
 
 
@@ -50,6 +62,50 @@ class FaultSpec:
         return out
 
 
+@dataclass(frozen=True)
+class Fate:
+    """What the active faults do to one frame."""
+
+    drop: bool = False
+    delay_ns: int = 0
+    corrupt_bit: int | None = None  # bit index in bytes 1..7 to flip
+    duplicate: bool = False
+    failed_attempts: int = 0
+
+
+NO_FATE = Fate()
+PAYLOAD_BITS = 56  # bytes 1..7: the CRC byte itself is not flipped, the CRC must catch it
+
+
+def frame_fate(active: list[FaultSpec], name: str, sender: str, rng: Any) -> Fate:
+    """Fate of one frame of ``name`` from ``sender`` under the ``active`` faults.
+
+    Draws from ``rng`` only for matching faults, in the order they were started, so the
+    same seed gives the same fates (lockstep determinism).
+    """
+    drop = dup = False
+    delay = fails = 0
+    bit = None
+    for f in active:
+        if f.kind not in FRAME_KINDS or not (f.message == name or f.node == sender):
+            continue
+        if rng.random() >= f.params["probability"]:
+            continue
+        if f.kind == "drop":
+            drop = True
+        elif f.kind == "delay":
+            delay += round(f.params["delay_s"] * 1e9)
+        elif f.kind == "corrupt":
+            bit = int(rng.integers(PAYLOAD_BITS))
+        elif f.kind == "duplicate":
+            dup = True
+        else:
+            fails += 1
+    if not (drop or dup or delay or fails or bit is not None):
+        return NO_FATE
+    return Fate(drop, delay, bit, dup, fails)
+
+
 def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
                  messages: frozenset[str], nodes: frozenset[str]) -> tuple[FaultSpec, ...]:
     """Validate ``[[faults]]`` tables; sorted by start time."""
@@ -63,14 +119,23 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
             if k >= n_thrusters:
                 raise f.error("thruster", k, f"a thruster index 0..{n_thrusters - 1}")
             spec = FaultSpec(t_s, kind, dur, thruster=k)
-        elif kind == "link_error":
+        elif kind in FRAME_KINDS:
             message = (f.string("message", choices=tuple(sorted(messages)))
                        if f.has("message") else None)
             node = f.string("node", choices=tuple(sorted(nodes))) if f.has("node") else None
             if (message is None) == (node is None):
                 raise f.error("message", None, "exactly one of message = NAME or node = NAME")
-            p = f.number("probability", 1.0, lo=0.0, lo_open=True, hi=1.0)
-            spec = FaultSpec(t_s, kind, dur, message=message, node=node, params={"probability": p})
+            params = {"probability": f.number("probability", 1.0, lo=0.0, lo_open=True, hi=1.0)}
+            if kind == "delay":
+                params["delay_s"] = f.number("delay_s", lo=0.0, lo_open=True, hi=1.0)
+            spec = FaultSpec(t_s, kind, dur, message=message, node=node, params=params)
+        elif kind == "babbling":
+            can_id = f.integer("can_id", lo=0)
+            if can_id > MAX_STD_ID:
+                raise f.error("can_id", can_id, f"an 11-bit ID 0..{MAX_STD_ID}")
+            rate_hz = f.number("rate_hz", lo=0.0, lo_open=True, hi=MAX_RATE_HZ)
+            spec = FaultSpec(t_s, kind, dur, node=f.string("node", "BABBLER"),
+                             params={"can_id": can_id, "rate_hz": rate_hz})
         else:  # bus_off
             spec = FaultSpec(t_s, kind, dur, node=f.string("node", choices=tuple(sorted(nodes))))
         f.done()

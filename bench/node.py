@@ -31,7 +31,7 @@ import numpy as np
 from cantools.database.can import Database
 
 from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_time_ns
-from bench.faults import BUS_KINDS, FaultSpec
+from bench.faults import BUS_KINDS, NO_FATE, FaultSpec, frame_fate
 from bench.metrics import expectation, latency_summary, pointing_metrics
 from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder
@@ -65,6 +65,13 @@ def quat_error_deg(q: tuple[float, ...] | np.ndarray, r: tuple[float, ...]) -> f
     """Rotation angle between attitudes q and r [deg]."""
     d = abs(q[0] * r[0] + q[1] * r[1] + q[2] * r[2] + q[3] * r[3])
     return 2.0 * math.acos(min(1.0, d)) * RAD_DEG
+
+
+def _flip(msg: can.Message, bit: int) -> None:
+    """Flip payload bit ``bit`` (0..55) of bytes 1..7 of ``msg`` in place."""
+    data = bytearray(msg.data)
+    data[1 + bit // 8] ^= 1 << (bit % 8)
+    msg.data = data
 
 
 def _clip(x: float, limit: float) -> float:
@@ -187,8 +194,12 @@ class BenchNode:
         self.faults_log: list[dict[str, Any]] = []
         self.pending_faults = list(sc.faults)
         self.active_faults: list[tuple[FaultSpec, int | None]] = []
+        self.delayed: list[tuple[int, can.Message, str]] = []
+        self.fault_counts: dict[str, int] = {
+            k: 0 for k in ("dropped", "delayed", "corrupted", "duplicated", "babbled")}
         self.fault_rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
         self.sender_of = {m.name: (m.senders[0] if m.senders else "") for m in db.messages}
+        self.name_of = {m.frame_id: m.name for m in db.messages}
         self.on_time_last = [0.0] * self.n_thr
         self.tel_t: list[float] = []
         self.tel_err: list[float] = []
@@ -326,14 +337,10 @@ class BenchNode:
         self.faults_log.append(rec)
         self.trace.event(t_ns, "fault_injected", **rec)
 
-    def _failed_attempts(self, name: str) -> int:
-        """Link errors drawn for one frame of ``name`` (0 or 1) from the active faults."""
-        for f, _ in self.active_faults:
-            if f.kind == "link_error" and (
-                f.message == name or (f.node is not None and f.node == self.sender_of[name])
-            ) and self.fault_rng.random() < f.params["probability"]:
-                return 1
-        return 0
+    @property
+    def active_faults_specs(self) -> list[FaultSpec]:
+        """The faults active now, in the order they started."""
+        return [f for f, _ in self.active_faults]
 
     def _watchdog(self, t_ns: int) -> None:
         if (
@@ -359,6 +366,8 @@ class BenchNode:
         for _, t_end in self.active_faults:
             if t_end is not None:
                 nxt = min(nxt, _step_ceil(t_end))
+        for t_release, _, _ in self.delayed:
+            nxt = min(nxt, _step_ceil(t_release))
         if not self.watchdog_tripped:
             nxt = min(
                 nxt,
@@ -378,6 +387,8 @@ class BenchNode:
             t = min(t_end_ns, self._next_event_ns(self.plant.t_ns))
             self.plant.advance_to(t)
             self._faults_due(t)
+            if self.delayed:
+                self._release_delayed(t)
             self._watchdog(t)
             if t % TELEMETRY_PERIOD_NS == 0:
                 self._telemetry_row(t)
@@ -397,19 +408,65 @@ class BenchNode:
         realtime_ns: int | None = None,
     ) -> can.Message:
         msg = self.encoder.message(name, signals)
-        self.bus.send(msg)
-        self.sent[name] = self.sent.get(name, 0) + 1
-        if realtime_ns is not None:
-            self.trace.frame(msg, realtime_ns, tx=True, t_ready_ns=realtime_ns, t_rx_ns=NAN,
-                             bits=frame_bits(msg.arbitration_id, bytes(msg.data)))
-        else:
-            bits = frame_bits(msg.arbitration_id, bytes(msg.data))
-            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits, node=BENCH_NODE,
-                                      failed_attempts=self._failed_attempts(name))
-            self._wire_pending[seq] = (msg, True, bits)
+        fate = (frame_fate(self.active_faults_specs, name, BENCH_NODE, self.fault_rng)
+                if self.active_faults else NO_FATE)
         if name == "IMU_RATE":
             self.imu_tx_ns[msg.data[1] & 0x0F] = ready_ns if realtime_ns is None else realtime_ns
+        if fate is not NO_FATE:
+            if fate.drop:
+                self.fault_counts["dropped"] += 1
+                return msg
+            if fate.delay_ns and realtime_ns is None:
+                self.fault_counts["delayed"] += 1
+                self.delayed.append((ready_ns + fate.delay_ns, msg, name))
+                return msg
+            if fate.corrupt_bit is not None:
+                self.fault_counts["corrupted"] += 1
+                _flip(msg, fate.corrupt_bit)
+        copies = 2 if fate.duplicate else 1
+        if copies == 2:
+            self.fault_counts["duplicated"] += 1
+        for _ in range(copies):
+            self._put_on_bus(msg, name, ready_ns, realtime_ns, fate.failed_attempts)
         return msg
+
+    def _put_on_bus(self, msg: can.Message, name: str, ready_ns: int, realtime_ns: int | None,
+                    failed_attempts: int = 0) -> None:
+        self.bus.send(msg)
+        self.sent[name] = self.sent.get(name, 0) + 1
+        bits = frame_bits(msg.arbitration_id, bytes(msg.data))
+        if realtime_ns is not None:
+            self.trace.frame(msg, realtime_ns, tx=True, t_ready_ns=realtime_ns, t_rx_ns=NAN,
+                             bits=bits)
+        else:
+            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits, node=BENCH_NODE,
+                                      failed_attempts=failed_attempts)
+            self._wire_pending[seq] = (msg, True, bits)
+
+    def _release_delayed(self, t_ns: int) -> None:
+        """Put delayed bench frames whose time has come on the bus."""
+        due = [d for d in self.delayed if d[0] <= t_ns]
+        for item in sorted(due, key=lambda d: (d[0], d[1].arbitration_id)):
+            self.delayed.remove(item)
+            self._put_on_bus(item[1], item[2], item[0], None)
+
+    def _babble(self, t0_ns: int, t1_ns: int) -> None:
+        """Frames of the active babbling nodes for [t0, t1): on the bus and on the wire model."""
+        for f in self.active_faults_specs:
+            if f.kind != "babbling":
+                continue
+            step = round(NS_PER_S / f.params["rate_hz"])
+            t = -(-t0_ns // step) * step
+            while t < t1_ns:
+                data = bytes(self.fault_rng.integers(0, 256, 8, dtype=np.uint8))
+                msg = can.Message(arbitration_id=int(f.params["can_id"]), is_extended_id=False,
+                                  data=data)
+                self.bus.send(msg)
+                self.fault_counts["babbled"] += 1
+                bits = frame_bits(msg.arbitration_id, data)
+                seq = self.arbiter.submit(t, msg.arbitration_id, bits, node=str(f.node))
+                self._wire_pending[seq] = (msg, True, bits)
+                t += step
 
     def _flush_wire(self, until_ns: int | None = None) -> dict[int, int]:
         """Resolve bus arbitration; record frames in wire order. Returns seq -> rx time."""
@@ -519,36 +576,53 @@ class BenchNode:
         # frames can arrive, and record the bench's own frames already on the wire.
         self.integrate_to(max(self.plant.t_ns, ready_ns // STEP_NS * STEP_NS))
         self._flush_wire(ready_ns)
+        self._babble(k * self.period_ns, (k + 1) * self.period_ns)
         want = self.n_cmd_frames
-        got: list[tuple[int, int, dict[str, float]]] = []  # (frame index, seq, signals)
+        got: list[tuple[int, int, dict[str, float], int]] = []  # (frame, seq, signals, delay)
+        lost = 0  # command frames that faults kept from the bench this cycle
         fsw_dead = self.fsw_alive is not None and not self.fsw_alive()
         timeout = 0.0 if (self.fsw_silent or fsw_dead) else self.sc.bus.stall_timeout_s
         deadline = time.monotonic() + timeout
         imu_counter = None
-        while len(got) < want:
+        while len(got) + lost < want:
             remaining = deadline - time.monotonic()
             msg = self.bus.recv(timeout=max(0.0, remaining))
             if msg is None:
                 break
-            d = self.checker.check(msg)
-            if d is None:
+            name = self.name_of.get(msg.arbitration_id)
+            fate = (frame_fate(self.active_faults_specs, name, self.sender_of[name], self.fault_rng)
+                    if self.active_faults and name is not None else NO_FATE)
+            if fate.drop:
+                self.fault_counts["dropped"] += 1
+                lost += bool(name and name.startswith("THR_CMD_"))
                 continue
-            bits = frame_bits(msg.arbitration_id, bytes(msg.data))
-            seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits,
-                                      node=self.sender_of[d.name],
-                                      failed_attempts=self._failed_attempts(d.name))
-            self._wire_pending[seq] = (msg, False, bits)
-            s: dict[str, float] = d.signals
-            if d.name.startswith("THR_CMD_"):
-                if int(s["Cycle"]) != k % CYCLE_MODULUS:
-                    self.checker.reject(d.name, Reject.STALE)
+            if fate.corrupt_bit is not None:
+                self.fault_counts["corrupted"] += 1
+                _flip(msg, fate.corrupt_bit)
+            self.fault_counts["duplicated"] += fate.duplicate
+            self.fault_counts["delayed"] += bool(fate.delay_ns)
+            for _copy in range(2 if fate.duplicate else 1):
+                bits = frame_bits(msg.arbitration_id, bytes(msg.data))
+                seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits,
+                                          node=self.sender_of.get(name or "", "?"),
+                                          failed_attempts=fate.failed_attempts)
+                self._wire_pending[seq] = (msg, False, bits)
+                d = self.checker.check(msg)
+                if d is None:
+                    if name is not None and name.startswith("THR_CMD_") and _copy == 0:
+                        lost += 1  # rejected (e.g. corrupted): this cycle will not get it
                     continue
-                got.append((int(d.name[-1]), seq, s))
-                imu_counter = int(s["ImuCounter"])
-            else:
-                self._on_fsw_frame(d.name, s)
+                s: dict[str, float] = d.signals
+                if d.name.startswith("THR_CMD_"):
+                    if int(s["Cycle"]) != k % CYCLE_MODULUS:
+                        self.checker.reject(d.name, Reject.STALE)
+                        continue
+                    got.append((int(d.name[-1]), seq, s, fate.delay_ns))
+                    imu_counter = int(s["ImuCounter"])
+                else:
+                    self._on_fsw_frame(d.name, s)
         rx = self._flush_wire(ready_ns + self.period_ns)
-        if len(got) < want:
+        if len(got) + lost < want:
             self.stalls += 1
             self.consecutive_stalls += 1
             if not self.fsw_silent:
@@ -565,8 +639,8 @@ class BenchNode:
             return
         t_last = 0
         t_fire: int | None = None
-        for index, seq, s in sorted(got):
-            t_rx = rx[seq]
+        for index, seq, s, delay_ns in sorted(got, key=lambda g: (g[0], g[1])):
+            t_rx = rx[seq] + delay_ns
             t_last = max(t_last, t_rx)
             if self._apply_command(s, index, t_rx) and (t_fire is None or t_rx < t_fire):
                 t_fire = t_rx
@@ -698,6 +772,7 @@ class BenchNode:
             },
             "valve_watchdog_trips": self.watchdog_trips,
             "faults": self.faults_log,
+            "fault_effects": dict(self.fault_counts),
             "expectations": exps,
             "passed": all(x["pass"] for x in exps) and pm.converged,
         }

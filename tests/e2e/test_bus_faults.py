@@ -19,7 +19,9 @@ BUS_OFF_S = 2.5
 DURATION_S = "4"
 TOL_US = 0.5  # rounding of modelled times to the microsecond in frames.csv/chains.csv
 THR_CMD_BITS_MAX = 135
-STUFFING_TOL_US = 10.0  # a few stuff bits per frame on the path at 1 us/bit  # 8-byte frame, worst-case stuffing
+STUFFING_TOL_US = (
+    10.0  # a few stuff bits per frame on the path at 1 us/bit  # 8-byte frame, worst-case stuffing
+)
 
 
 def _latencies_us(out: Path) -> dict[int, float]:
@@ -69,3 +71,55 @@ def test_link_errors_and_bus_off_delay_commands_as_modelled(
         assert lat[k] == pytest.approx(base[k], abs=STUFFING_TOL_US), k
     faults = run.summary["faults"]
     assert [f["kind"] for f in faults] == ["link_error", "bus_off"]
+
+
+def _fault(kind: str, target: str, **params: object) -> str:
+    body = "".join(f"{k} = {v!r}\n".replace("'", '"') for k, v in params.items())
+    return f'\n[[faults]]\nkind = "{kind}"\n{target}\n{body}'
+
+
+DROP_P = 0.1
+DROP_SIGMAS = 5.0  # binomial tolerance on the drop fraction
+
+
+def test_frame_faults_have_their_counted_effects(tmp_path: Path, runtime_dir: Path) -> None:
+    """drop ~ p; corrupt -> CRC rejects; duplicate -> counter rejects; babbling -> unknown IDs."""
+    sc = tmp_path / "frame_faults.toml"
+    sc.write_text(
+        QUICKSTART.read_text()
+        + _fault("drop", 'message = "IMU_RATE"', t_s=0.0, probability=DROP_P)
+        + _fault("corrupt", 'message = "STR_QUAT"', t_s=1.0, duration_s=1.0)
+        + _fault("duplicate", 'message = "THR_CMD_0"', t_s=2.0, duration_s=1.0)
+        + _fault("babbling", "can_id = 1", t_s=3.0, duration_s=0.5, rate_hz=2000.0)
+    )
+    s = run_cli(
+        ["run", str(sc), "--bus", unique_bus(), "--duration", DURATION_S],
+        tmp_path / "run",
+        runtime_dir,
+    ).summary
+    eff, frames = s["fault_effects"], s["frames"]
+    offered = frames["IMU_RATE"]["sent"] + eff["dropped"]
+    sigma = (offered * DROP_P * (1 - DROP_P)) ** 0.5
+    assert abs(eff["dropped"] - DROP_P * offered) <= DROP_SIGMAS * sigma
+    assert frames["IMU_RATE"]["gaps"] == eff["dropped"]  # the receiver sees them as gaps
+    assert frames["STR_QUAT"]["rejected"] == {"crc": eff["corrupted"]} and eff["corrupted"] > 0
+    assert frames["THR_CMD_0"]["rejected"] == {"counter": eff["duplicated"]}
+    assert frames["0x001"]["rejected"] == {"unknown_id": eff["babbled"]}
+    assert s["deadline_misses"]["stalls"] == 0
+
+
+def test_ten_percent_loss_of_every_sensor_message_still_converges(
+    tmp_path: Path, runtime_dir: Path
+) -> None:
+    """10 % random loss of IMU, accelerometer, star tracker and valve status: quickstart passes."""
+    sc = tmp_path / "loss.toml"
+    sc.write_text(
+        QUICKSTART.read_text()
+        + "".join(
+            _fault("drop", f'message = "{m}"', t_s=0.0, probability=DROP_P)
+            for m in ("IMU_RATE", "IMU_ACCEL", "STR_QUAT", "THR_STATUS")
+        )
+    )
+    r = run_cli(["run", str(sc), "--bus", unique_bus()], tmp_path / "run", runtime_dir)
+    assert r.returncode == 0, r.stdout
+    assert r.summary["converged"] and all(e["pass"] for e in r.summary["expectations"])
