@@ -236,7 +236,7 @@ class BenchNode:
             "fsw_mode",
         ]
         cols += [f"thrust_T{k:02d}_N" for k in range(len(self.sc.thrusters))]
-        return cols + ["propellant_kg"]
+        return [*cols, "propellant_kg", "active_faults"]
 
     def _telemetry_row(self, t_ns: int) -> None:
         s = self.plant.state
@@ -251,6 +251,7 @@ class BenchNode:
         row += [est_err, int(self.fsw_status.get("Mode", -1))]
         row += [thr.valves[k].thrust_N(t_ns) for k in range(self.n_thr)]
         row.append(thr.total_propellant_kg)
+        row.append(len(self.active_faults))
         self.telemetry.row(row)
         if t_ns >= self.sc.manoeuvre_start_s * NS_PER_S:
             self.tel_t.append(t_ns / NS_PER_S)

@@ -29,6 +29,9 @@ import can
 
 NS_PER_S = 1e9
 NAN = float("nan")
+# events also written into trace.asc (python-can's ASC reader skips such lines)
+TRACE_EVENTS = frozenset({"fault_injected", "fault_cleared", "valve_watchdog",
+                          "valve_watchdog_cleared", "fsw_silent", "fsw_back"})
 COUNTER_MASK = 0x0F
 FRAME_COLUMNS = ["t_ready_s", "t_start_s", "t_rx_s", "id", "dlc", "bits", "tx", "counter"]
 CHAIN_COLUMNS = ["cycle", "imu_counter", "t_imu_tx_s", "t_cmd_rx_s", "t_valve_open_s"]
@@ -76,6 +79,9 @@ class TraceRecorder:
         """Append one event line (``what`` at ``t_ns`` with ``fields``) and flush it."""
         self._events.write(json.dumps({"event": what, **fields, "t_s": t_ns / NS_PER_S}) + "\n")
         self._events.flush()
+        if what in TRACE_EVENTS:  # also in the CAN trace, as an ASC event line
+            text = " ".join(f"{k}={v}" for k, v in fields.items() if k != "t_s")
+            self._writer.log_event(f"thruster-hil {what} {text}".rstrip(), t_ns / NS_PER_S)
 
     def flush(self) -> None:
         """Flush the trace and the frame timing to disk."""
