@@ -141,3 +141,43 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
         f.done()
         out.append(spec)
     return tuple(sorted(out, key=lambda x: x.t_s))
+
+
+# FAULT_CMD.FaultType values (the DBC's VAL_ table) this bench acts on, and FAULT_CMD.Target
+# node indices for node faults.
+FAULT_CMD_KINDS = {1: "stuck_closed", 2: "stuck_open", 8: "drop", 9: "delay", 10: "corrupt",
+                   11: "duplicate", 12: "babbling", 13: "bus_off", 14: "link_error"}
+FAULT_CMD_NODES = ("BENCH", "FSW")
+KHZ = 1000.0
+
+
+def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thrusters: int,
+                       t_s: float) -> FaultSpec | None:
+    """The fault a FAULT_CMD frame describes (see its DBC comments), or None if unsupported.
+
+    Target is a thruster index (thruster kinds), the CAN ID of a message (frame kinds), the
+    CAN ID to babble with (babbling), or a node index (bus_off). Param is the probability
+    (frame kinds), the delay in seconds (delay) or the rate in kHz (babbling).
+    """
+    kind = FAULT_CMD_KINDS.get(int(signals["FaultType"]))
+    target, param = int(signals["Target"]), float(signals["Param"])
+    dur = float(signals["Duration"])
+    if kind is None:
+        return None
+    if kind in THRUSTER_KINDS:
+        return FaultSpec(t_s, kind, dur, thruster=target) if target < n_thrusters else None
+    if kind == "bus_off":
+        return (FaultSpec(t_s, kind, dur, node=FAULT_CMD_NODES[target])
+                if target < len(FAULT_CMD_NODES) else None)
+    if kind == "babbling":
+        return (FaultSpec(t_s, kind, dur, node="BABBLER",
+                          params={"can_id": target, "rate_hz": param * KHZ})
+                if param > 0 and target <= MAX_STD_ID else None)
+    message = name_of.get(target)
+    if message is None:
+        return None
+    if kind == "delay":
+        return FaultSpec(t_s, kind, dur, message=message,
+                         params={"probability": 1.0, "delay_s": param}) if param > 0 else None
+    p = param if param > 0 else 1.0
+    return FaultSpec(t_s, kind, dur, message=message, params={"probability": min(p, 1.0)})

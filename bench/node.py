@@ -31,7 +31,7 @@ import numpy as np
 from cantools.database.can import Database
 
 from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_time_ns
-from bench.faults import BUS_KINDS, NO_FATE, FaultSpec, frame_fate
+from bench.faults import BUS_KINDS, NO_FATE, FaultSpec, fault_from_command, frame_fate
 from bench.metrics import expectation, latency_summary, pointing_metrics
 from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder
@@ -41,6 +41,7 @@ from dbc.errors import RunError
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 
 WATCHDOG_PERIODS = 3
+FAULT_CMD_NONE = 15  # BENCH_STATUS.FaultCmdCounter before any FAULT_CMD
 FAULT_RNG_STREAM = 0xFA  # spawn key of the fault-injection random stream
 BENCH_NODE = "BENCH"
 STARTUP_POLL_S = 0.2
@@ -65,6 +66,10 @@ def quat_error_deg(q: tuple[float, ...] | np.ndarray, r: tuple[float, ...]) -> f
     """Rotation angle between attitudes q and r [deg]."""
     d = abs(q[0] * r[0] + q[1] * r[1] + q[2] * r[2] + q[3] * r[3])
     return 2.0 * math.acos(min(1.0, d)) * RAD_DEG
+
+
+def _same_target(a: FaultSpec, b: FaultSpec) -> bool:
+    return (a.kind, a.thruster, a.message, a.node) == (b.kind, b.thruster, b.message, b.node)
 
 
 def _flip(msg: can.Message, bit: int) -> None:
@@ -195,6 +200,7 @@ class BenchNode:
         self.pending_faults = list(sc.faults)
         self.active_faults: list[tuple[FaultSpec, int | None]] = []
         self.delayed: list[tuple[int, can.Message, str]] = []
+        self.fault_cmd_counter = FAULT_CMD_NONE
         self.fault_counts: dict[str, int] = {
             k: 0 for k in ("dropped", "delayed", "corrupted", "duplicated", "babbled")}
         self.fault_rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
@@ -300,6 +306,7 @@ class BenchNode:
             "SimTime": t_ns / NS_PER_S,
             "ActiveFaults": len(self.active_faults),
             "Health": health,
+            "FaultCmdCounter": self.fault_cmd_counter,
         }
 
     def _queue_due(self, t_ns: int) -> None:
@@ -323,8 +330,9 @@ class BenchNode:
                 self.plant.thrusters.set_fault(f.thruster, None, t_ns)
             self.trace.event(t_ns, "fault_cleared", **f.record())
 
-    def _start_fault(self, f: FaultSpec, t_ns: int, end_ns: int | None) -> None:
-        rec = {**f.record(), "t_s": t_ns / NS_PER_S, "source": "scenario"}
+    def _start_fault(self, f: FaultSpec, t_ns: int, end_ns: int | None,
+                     source: str = "scenario") -> None:
+        rec = {**f.record(), "t_s": t_ns / NS_PER_S, "source": source}
         if f.kind in BUS_KINDS and self.mode != "lockstep":
             rec["applied"] = False
             rec["why"] = "bus faults act on the modelled bus (lockstep runs only)"
@@ -486,14 +494,35 @@ class BenchNode:
             self._send(name, sig, t_ns, realtime_ns)
         self.queue.clear()
 
-    def _on_fsw_frame(self, d_name: str, s: dict[str, float]) -> None:
-        if d_name == "FSW_STATUS":
+    def _on_fsw_frame(self, d_name: str, s: dict[str, float], counter: int = 0) -> None:
+        if d_name == "FAULT_CMD":
+            self._on_fault_cmd(s, counter)
+        elif d_name == "FSW_STATUS":
             self.fsw_status = s
         elif d_name == "FSW_ATT_EST":
             self.fsw_q_est = unpack_quaternion(s)
             # the estimate is of the cycle's time t_k, which is where the plant is now (lockstep)
             self.fsw_est_err_deg = quat_error_deg(self.plant.state[0:4], self.fsw_q_est)
             self.fsw_q_valid = bool(s["Valid"])
+
+    def _on_fault_cmd(self, s: dict[str, float], counter: int) -> None:
+        """A live FAULT_CMD: inject or clear, acknowledged in BENCH_STATUS.FaultCmdCounter."""
+        self.fault_cmd_counter = counter
+        t = max(self.plant.t_ns, self.last_cmd_ns)  # valve events must stay in time order
+        spec = fault_from_command(s, self.name_of, self.n_thr, t / NS_PER_S)
+        if spec is None:
+            self.trace.event(t, "fault_cmd_rejected", **{k: float(v) for k, v in s.items()
+                                                        if k not in ("CRC", "AliveCounter")})
+            return
+        if int(s["Action"]) == 0:
+            for item in [x for x in self.active_faults if _same_target(x[0], spec)]:
+                self.active_faults.remove(item)
+                if item[0].thruster is not None:
+                    self.plant.thrusters.set_fault(item[0].thruster, None, t)
+                self.trace.event(t, "fault_cleared", **item[0].record(), source="FAULT_CMD")
+            return
+        end = t + round(spec.duration_s * NS_PER_S) if spec.duration_s > 0 else None
+        self._start_fault(spec, t, end, source="FAULT_CMD")
 
     def _apply_command(self, s: dict[str, float], frame_index: int, t_rx_ns: int) -> bool:
         """Deliver one THR_CMD frame to its valves at ``t_rx_ns``; True if any valve fires."""
@@ -536,7 +565,7 @@ class BenchNode:
             d = self.checker.check(msg)
             if d is not None:
                 self.trace.frame(msg, 0, tx=False)
-                self._on_fsw_frame(d.name, d.signals)
+                self._on_fsw_frame(d.name, d.signals, d.counter)
                 return
         raise RunError(
             f"no flight software on bus {self.bus_spec} within "
@@ -621,7 +650,7 @@ class BenchNode:
                     got.append((int(d.name[-1]), seq, s, fate.delay_ns))
                     imu_counter = int(s["ImuCounter"])
                 else:
-                    self._on_fsw_frame(d.name, s)
+                    self._on_fsw_frame(d.name, s, d.counter)
         rx = self._flush_wire(ready_ns + self.period_ns)
         if len(got) + lost < want:
             self.stalls += 1
@@ -701,6 +730,7 @@ class BenchNode:
         )
         s: dict[str, float] = d.signals
         if d.name.startswith("THR_CMD_"):
+            self.integrate_to(max(self.plant.t_ns, t_ns // STEP_NS * STEP_NS))
             t_apply = max(t_ns, self.plant.t_ns)
             index = int(d.name[-1])
             if self._apply_command(s, index, t_apply):
@@ -712,7 +742,7 @@ class BenchNode:
                 self._chain(int(s["Cycle"]), int(s["ImuCounter"]), t_ns, self._rt_fire_ns)
                 self._rt_fire_ns = None
         else:
-            self._on_fsw_frame(d.name, s)
+            self._on_fsw_frame(d.name, s, d.counter)
 
     # -- results -----------------------------------------------------------------
     def summary(self, sim_time_s: float) -> dict[str, Any]:

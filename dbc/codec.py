@@ -107,11 +107,20 @@ class Encoder:
         except KeyError:
             raise IcdError(f"no message {name!r} in the DBC") from None
 
-    def encode(self, name: str, signals: dict[str, float | int]) -> bytearray:
-        """Payload of ``name`` with ``signals`` (physical units), next counter and CRC."""
+    def encode(self, name: str, signals: dict[str, float | int],
+               counter: int | None = None) -> bytearray:
+        """Payload of ``name`` with ``signals`` (physical units), counter and CRC.
+
+        ``counter`` defaults to this encoder's next alive counter for ``name``; an explicit
+        one (for a sender resuming someone else's sequence) also becomes the new last value.
+        """
         message, did = self._lookup(name)
-        counter = self._counters.get(name, -1)
-        counter = (counter + 1) % e2e.COUNTER_MODULUS
+        if counter is None:
+            counter = (self._counters.get(name, -1) + 1) % e2e.COUNTER_MODULUS
+        elif not 0 <= counter < e2e.COUNTER_MODULUS:
+            raise IcdError(
+                f"alive counter {counter} of {name}: expected 0..{e2e.COUNTER_MODULUS - 1}"
+            )
         self._counters[name] = counter
         values: dict[str, Any] = {"CRC": 0, "AliveCounter": counter}
         values.update(signals)

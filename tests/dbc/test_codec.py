@@ -58,9 +58,12 @@ def test_bad_frames_are_counted_by_cause(db) -> None:  # type: ignore[no-untyped
         )
         is None
     )
-    # FAULT_CMD.FaultType has 6 bits but its DBC range is 0..2: raw 3 is out of range
-    fault = enc.encode("FAULT_CMD", {"Action": 1, "FaultType": 1, "Target": 0, "Duration": 0})
-    fault[1] |= 0xC0  # FaultType's two low bits (bits 14, 15) -> 3
+    # FAULT_CMD.FaultType has 6 bits but its DBC range is 0..18: raw 63 is out of range
+    fault = enc.encode(
+        "FAULT_CMD", {"Action": 1, "FaultType": 1, "Target": 0, "Duration": 0, "Param": 0}
+    )
+    fault[1] |= 0xC0  # FaultType bits 14, 15
+    fault[2] |= 0x0F  # FaultType bits 16..19
     e2e.protect(data_id(db.get_message_by_name("FAULT_CMD")), fault, e2e.counter_of(fault))
     assert chk.check(_frame(bytes(fault), can_id=0x7E0)) is None
     s = chk.summary()

@@ -1,0 +1,82 @@
+"""Live fault injection over the bus: one FAULT_CMD frame, acknowledged by the bench.
+
+The operator side of ``thruster-hil inject``. It listens for BENCH_STATUS to learn the last
+FAULT_CMD alive counter the bench accepted (``FaultCmdCounter``), sends FAULT_CMD with the
+next counter (so the bench's E2E check accepts a new sender), and waits for a BENCH_STATUS
+that acknowledges it. Any CAN tool can do the same: :func:`cansend_string` prints the frame
+in can-utils ``cansend`` syntax. Frames in: BENCH_STATUS; out: FAULT_CMD.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import can
+
+from dbc import e2e, load_database
+from dbc.bus import open_bus
+from dbc.codec import Encoder, FrameChecker
+from dbc.errors import RunError
+
+COUNTER_NONE = 15
+DEFAULT_TIMEOUT_S = 5.0
+KIND_CODES = {"stuck_closed": 1, "stuck_open": 2, "drop": 8, "delay": 9, "corrupt": 10,
+              "duplicate": 11, "babbling": 12, "bus_off": 13, "link_error": 14}
+
+
+@dataclass(frozen=True)
+class FaultCommand:
+    """What to send (see FAULT_CMD's signal comments in the DBC)."""
+
+    kind: str
+    target: int
+    duration_s: float = 0.0
+    param: float = 0.0
+    clear: bool = False
+
+    def __post_init__(self) -> None:
+        if self.kind not in KIND_CODES:
+            raise RunError(f"fault kind {self.kind!r}: expected one of {', '.join(KIND_CODES)}")
+
+    def signals(self) -> dict[str, float | int]:
+        """FAULT_CMD signal values."""
+        return {"Action": 0 if self.clear else 1, "FaultType": KIND_CODES[self.kind],
+                "Target": self.target, "Duration": self.duration_s, "Param": self.param}
+
+
+def cansend_string(cmd: FaultCommand, counter: int) -> str:
+    """The FAULT_CMD frame as ``ID#HEXDATA`` for can-utils ``cansend``."""
+    db = load_database()
+    data = Encoder(db).encode("FAULT_CMD", cmd.signals(), counter=counter)
+    return f"{db.get_message_by_name('FAULT_CMD').frame_id:03X}#{bytes(data).hex().upper()}"
+
+
+def inject(bus_spec: str, cmd: FaultCommand, timeout_s: float = DEFAULT_TIMEOUT_S) -> int:
+    """Send ``cmd`` on ``bus_spec``, wait for the bench's acknowledgement; returns the counter."""
+    db = load_database()
+    checker = FrameChecker(db, accept=frozenset({"BENCH_STATUS"}))
+    with open_bus(bus_spec) as bus:
+        last = _bench_status(bus, checker, timeout_s)
+        counter = 0 if last == COUNTER_NONE else (last + 1) % e2e.COUNTER_MODULUS
+        frame = db.get_message_by_name("FAULT_CMD")
+        bus.send(can.Message(arbitration_id=frame.frame_id, is_extended_id=False,
+                             data=Encoder(db).encode("FAULT_CMD", cmd.signals(), counter=counter)))
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if _bench_status(bus, checker, deadline - time.monotonic()) == counter:
+                return counter
+    raise RunError(f"no acknowledgement of FAULT_CMD (counter {counter}) on {bus_spec} "
+                   f"within {timeout_s} s")
+
+
+def _bench_status(bus: can.BusABC, checker: FrameChecker, timeout_s: float) -> int:
+    deadline = time.monotonic() + timeout_s
+    while (left := deadline - time.monotonic()) > 0:
+        msg = bus.recv(timeout=left)
+        if msg is None:
+            break
+        d = checker.check(msg)
+        if d is not None:
+            return int(d.signals["FaultCmdCounter"])
+    raise RunError(f"no BENCH_STATUS within {timeout_s:.1f} s: is a bench running on this bus?")
