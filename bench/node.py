@@ -89,41 +89,38 @@ def _step_ceil(t_ns: int) -> int:
     return -(-t_ns // STEP_NS) * STEP_NS
 
 
-def frame_table(
-    db: Database, me: str, sent: dict[str, int], received: dict[str, dict[str, Any]]
-) -> dict[str, dict[str, Any]]:
-    """Per message: its sender, and what node ``me`` knows (what it sent, or what it received).
+def frame_table(db: Database) -> dict[str, dict[str, Any]]:
+    """An empty per-message table of the ICD: sender, sent, received, gaps, rejected by cause.
 
-    The other side's counts are merged in by :func:`merge_peer_counts`.
+    ``sent`` comes from the sender, the rest from the receiver: :func:`merge_counts` fills
+    in one node's view at a time.
     """
-    table: dict[str, dict[str, Any]] = {}
-    for m in db.messages:
-        sender = m.senders[0] if m.senders else "?"
-        table[m.name] = {
-            "sender": sender,
-            "sent": None,
-            "received": None,
-            "gaps": None,
-            "rejected": {},
-        }
-    for name, n in sent.items():
-        table[name]["sent"] = n
-    for name, r in received.items():
-        row = table.setdefault(name, {"sender": "?", "sent": None})
-        row.update(received=r["received"], gaps=r["gaps"], rejected=r["rejected"])
-    return table
+    return {
+        m.name: {"sender": m.senders[0] if m.senders else "?", "sent": None, "received": None,
+                 "gaps": None, "rejected": {}}
+        for m in db.messages
+    }
 
 
-def merge_peer_counts(
-    table: dict[str, dict[str, Any]], sent: dict[str, int], received: dict[str, dict[str, Any]]
+def merge_counts(
+    table: dict[str, dict[str, Any]], other: dict[str, dict[str, int]], node: str,
+    sent: dict[str, int], received: dict[str, dict[str, Any]],
 ) -> None:
-    """Fill in the peer's side: what it sent and what it received, by message."""
+    """Merge what ``node`` sent and received into ``table``.
+
+    Frames that are no message of the ICD (unknown IDs, error frames) are summed per cause
+    into ``other[node]``, since every node receives them.
+    """
     for name, n in sent.items():
         if name in table:
             table[name]["sent"] = n
+    mine = other.setdefault(node, {})
     for name, r in received.items():
-        row = table.setdefault(name, {"sender": "?", "sent": None})
-        row.update(received=r["received"], gaps=r["gaps"], rejected=r["rejected"])
+        if name in table:
+            table[name].update(received=r["received"], gaps=r["gaps"], rejected=r["rejected"])
+        else:
+            for cause, n in r["rejected"].items():
+                mine[cause] = mine.get(cause, 0) + n
 
 
 @dataclass
@@ -633,10 +630,15 @@ class BenchNode:
             self.fault_counts["delayed"] += bool(fate.delay_ns)
             for _copy in range(2 if fate.duplicate else 1):
                 bits = frame_bits(msg.arbitration_id, bytes(msg.data))
-                seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits,
-                                          node=self.sender_of.get(name or "", "?"),
-                                          failed_attempts=fate.failed_attempts)
-                self._wire_pending[seq] = (msg, False, bits)
+                if name is not None and self.sender_of[name] != BENCH_NODE:
+                    # a frame of the flight software's cycle: on the modelled wire
+                    seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits,
+                                              node=self.sender_of[name],
+                                              failed_attempts=fate.failed_attempts)
+                    self._wire_pending[seq] = (msg, False, bits)
+                else:  # foreign traffic (unknown IDs, error frames, impostors): trace only
+                    seq = -1
+                    self.trace.frame(msg, ready_ns, tx=False, t_rx_ns=NAN, bits=bits)
                 d = self.checker.check(msg)
                 if d is None:
                     if name is not None and name.startswith("THR_CMD_") and _copy == 0:
@@ -756,7 +758,9 @@ class BenchNode:
             sc.expectations.steady_state_window_s,
             sc.manoeuvre_start_s,
         )
-        frames = frame_table(self.db, "BENCH", self.sent, self.checker.summary())
+        frames = frame_table(self.db)
+        other: dict[str, dict[str, int]] = {}
+        merge_counts(frames, other, BENCH_NODE, self.sent, self.checker.summary())
         e = sc.expectations
         exps = [
             x
@@ -795,6 +799,7 @@ class BenchNode:
             "propellant_kg": thr.total_propellant_kg,
             "valve_openings": {"total": int(sum(thr.openings)), "per_thruster": list(thr.openings)},
             "frames": frames,
+            "rejected_other": other,
             "latency_us": {"sensor_to_command": latency_summary(self.latency_ns)},
             "deadline_misses": {
                 "bench_late": self.late_steps,

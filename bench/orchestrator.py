@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bench.node import BenchNode, merge_peer_counts
+from bench.node import BenchNode, merge_counts
 from bench.plots import plot_run
 from bench.scenario import Scenario
 from dbc import load_database
@@ -132,9 +132,8 @@ def run_scenario(
         bus.shutdown()
     summary = node.close(opts.duration_s if error is None else node.plant.t_ns / 1e9)
     summary["fsw"] = _fsw_report(stats, fsw_rc, out)
-    merge_peer_counts(
-        summary["frames"], summary["fsw"].get("sent", {}), summary["fsw"].get("received", {})
-    )
+    merge_counts(summary["frames"], summary["rejected_other"], "FSW",
+                 summary["fsw"].get("sent", {}), summary["fsw"].get("received", {}))
     if isinstance(summary["deadline_misses"], dict):
         summary["deadline_misses"]["fsw_overruns"] = max(
             summary["deadline_misses"]["fsw_overruns"], summary["fsw"].get("overruns", 0)

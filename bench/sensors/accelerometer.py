@@ -18,6 +18,14 @@ Model: the gyro model of :mod:`bench.sensors.gyro` with accelerometer quantities
     Δt is the time since the previous sample (``period_s`` for the first one, whose bias
     is the initial bias exactly).
 
+Faults (``set_fault(kind, t_ns, **params)`` / ``clear_fault(kind, t_ns)``)
+    Those of :mod:`bench.sensors.gyro` (shared ``InertialSensor``), with accelerometer
+    units: ``"bias_jump"`` with ``jump_m_s2`` (3 numbers [m/s²], body axes, added to
+    the bias), ``"frozen"`` (output repeats the last sample, still valid),
+    ``"outage"`` (``sample`` raises ``SensorOutageError``, ``measure`` returns
+    ``valid = False``), ``"noise"`` with ``factor`` [-] ≥ 0 (multiplies the velocity
+    random walk σ). ``faults_active`` lists the active ones.
+
 Assumptions
     IMU at the centre of mass (no lever-arm ω×(ω×r) or ω̇×r terms), axes aligned with B,
     no scale-factor error, samples in strictly increasing time.
@@ -34,6 +42,7 @@ from bench.dynamics.rigid_body import Vec3
 from bench.sensors.gyro import (
     DEFAULT_PERIOD_S,
     S_PER_NS,
+    InertialSensor,
     check_number,
     check_vec3,
     output_limit,
@@ -77,28 +86,38 @@ class AccelerometerParams:
         put(self, "output_limit_m_s2", output_limit(self.lsb_m_s2, rng_))
 
 
-class Accelerometer:
+class Accelerometer(InertialSensor):
     """An accelerometer triad drawing its noise from ``rng`` (see the module docstring)."""
 
-    __slots__ = ("_bias", "_rng", "_t_prev_ns", "params")
+    __slots__ = ()
+    _NAME = "accelerometer"
+    _JUMP_KEY = "jump_m_s2"
 
     def __init__(self, params: AccelerometerParams, rng: np.random.Generator) -> None:
         self.params = params
-        self._rng = rng
-        self._bias: Vec3 = params.bias_m_s2
-        self._t_prev_ns: int | None = None
+        self._init_model(
+            rng,
+            params.bias_m_s2,
+            params.vrw_m_s_sqrt_s,
+            params.bias_rw_m_s2_sqrt_s,
+            params.lsb_m_s2,
+            params.output_limit_m_s2,
+            params.period_s,
+        )
 
     @property
     def bias_m_s2(self) -> Vec3:
-        """The current (true) bias [m/s²], for telemetry."""
+        """The current (true) bias [m/s²], for telemetry (a ``bias_jump`` included)."""
         return self._bias
 
     def sample(self, t_ns: int, specific_force_B_m_s2: Vec3) -> Vec3:
-        """Measured specific force [m/s²] at ``t_ns`` for the true ``specific_force_B_m_s2``."""
-        p = self.params
+        """Measured specific force [m/s²] at ``t_ns`` for the true ``specific_force_B_m_s2``.
+
+        Raises ``SensorOutageError`` during an ``outage`` fault (``measure`` returns a flag).
+        """
         prev = self._t_prev_ns
         if prev is None:
-            dt_s, walk = p.period_s, False
+            dt_s, walk = self._period_s, False
         elif t_ns > prev:
             dt_s, walk = (t_ns - prev) * S_PER_NS, True
         else:
@@ -111,10 +130,13 @@ class Accelerometer:
             self._bias,
             dt_s,
             walk,
-            p.vrw_m_s_sqrt_s,
-            p.bias_rw_m_s2_sqrt_s,
-            p.lsb_m_s2,
-            p.output_limit_m_s2,
+            self._white_density,
+            self._walk_density,
+            self._lsb,
+            self._limit,
         )
         self._t_prev_ns = t_ns
+        if self._faults:
+            return self._faulty(t_ns, out)
+        self._last_out = out
         return out

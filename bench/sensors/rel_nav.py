@@ -46,5 +46,8 @@ class RelNav:
         p, v = self.params.noise_pos_m, self.params.noise_vel_m_s
         pos = (r_N_m[0] + p * n[0], r_N_m[1] + p * n[1], r_N_m[2] + p * n[2])
         vel = (v_N_m_s[0] + v * n[3], v_N_m_s[1] + v * n[4], v_N_m_s[2] + v * n[5])
-        return (float(pos[0]), float(pos[1]), float(pos[2])), (
-            float(vel[0]), float(vel[1]), float(vel[2])), not self.outage
+        return (
+            (float(pos[0]), float(pos[1]), float(pos[2])),
+            (float(vel[0]), float(vel[1]), float(vel[2])),
+            not self.outage,
+        )

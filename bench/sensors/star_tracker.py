@@ -20,13 +20,28 @@ Inputs / outputs, frames and units
     Markley & Crassidis, "Fundamentals of Spacecraft Attitude Determination and
     Control", 2014, §5.4). δq = (cos(|θ|/2), sin(|θ|/2) θ/|θ|) (exact rotation vector map).
 
-Outage
-    ``set_outage(True)`` makes samples invalid: the output is frozen at the last valid
-    measurement (identity before any), with ``valid = False``.
+Faults (``set_fault(kind, t_ns, **params)`` / ``clear_fault(kind, t_ns)``; DESIGN.md §7)
+    Each applies from the next sample (the tracker keeps no clock: ``t_ns`` is the event
+    time, for the caller's records); several may be active; setting an active kind
+    again replaces its parameters; ``set_fault(None)`` clears all; ``faults_active``
+    lists them (kind → parameters). The 3 normals are drawn whatever is active.
+    - ``"outage"`` (no parameter; also ``set_outage(True/False)`` and the ``outage``
+      attribute): samples are invalid: the output is the last valid measurement
+      (identity before any), with ``valid = False``.
+    - ``"frozen"`` (no parameter): the output repeats the last measurement exactly
+      (the first one if there was none), reported valid: a stuck tracker.
+    - ``"noise"``, ``factor`` [-] ≥ 0: both noise σ (across and about the boresight)
+      are multiplied by ``factor``.
+    - ``"bias_jump"``, ``misalignment_arcsec`` (3 numbers [arcsec], body axes): a fixed
+      rotation vector β of the tracker mounting, applied to every output:
+      q̃_BN = q_BN ⊗ δq(β) ⊗ δq(θ) (δq the exact rotation-vector map above), so the
+      measured frame is rotated by |β| about β/|β| (plus the noise).
+    Precedence: outage, then frozen, then the live measurement. An inactive fault costs
+    one truth test per sample.
 
 Assumptions
     Tracker frame aligned with B apart from the boresight convention; noise white and
-    independent between samples; no bias, no aberration, no rate-induced smearing.
+    independent between samples; no aberration, no rate-induced smearing.
 """
 
 from __future__ import annotations
@@ -37,7 +52,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bench.dynamics.rigid_body import QUAT_IDENTITY, Quat, Vec3, quat_multiply
-from bench.sensors.gyro import check_number, check_vec3
+from bench.sensors.gyro import (
+    FAULT_BIAS_JUMP,
+    FAULT_FROZEN,
+    FAULT_NOISE,
+    FAULT_OUTAGE,
+    SensorFaultParams,
+    check_fault_kind,
+    check_number,
+    check_vec3,
+)
 from dbc.errors import ConfigError
 
 RAD_PER_ARCSEC = math.pi / (180.0 * 3600.0)
@@ -46,6 +70,25 @@ UNIT_NORM_TOL = 1e-6
 NORMALS_PER_SAMPLE = 3
 SMALL_ANGLE_RAD = 1e-12
 """Below this rotation angle δq is taken as identity plus θ/2 (avoids 0/0)."""
+STAR_TRACKER_FAULT_PARAMS: dict[str, tuple[str, ...]] = {
+    FAULT_OUTAGE: (),
+    FAULT_FROZEN: (),
+    FAULT_NOISE: ("factor",),
+    FAULT_BIAS_JUMP: ("misalignment_arcsec",),
+}
+"""Star-tracker fault kinds and their parameter names (see the module docstring)."""
+SOURCE = "star tracker"
+NOMINAL_NOISE_FACTOR = 1.0
+
+
+def rotation_vector_quat(theta: Vec3) -> Quat:
+    """δq = (cos(|θ|/2), sin(|θ|/2) θ/|θ|) of the rotation vector ``theta`` [rad]."""
+    tx, ty, tz = theta
+    angle = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if angle < SMALL_ANGLE_RAD:
+        return (1.0, 0.5 * tx, 0.5 * ty, 0.5 * tz)
+    s = math.sin(0.5 * angle) / angle
+    return (math.cos(0.5 * angle), s * tx, s * ty, s * tz)
 
 
 @dataclass(frozen=True)
@@ -91,11 +134,12 @@ class StarTracker:
 
     __slots__ = (
         "_axes",
+        "_bias_q",
+        "_faults",
         "_last",
         "_rng",
         "_sigma_about_rad",
         "_sigma_cross_rad",
-        "outage",
         "params",
     )
 
@@ -107,21 +151,96 @@ class StarTracker:
         self._axes = (e1, e2, b)
         self._sigma_cross_rad = params.noise_cross_arcsec * RAD_PER_ARCSEC
         self._sigma_about_rad = params.noise_about_arcsec * RAD_PER_ARCSEC
-        self._last: Quat = QUAT_IDENTITY
-        self.outage = False
+        self._last: Quat | None = None  # last valid output
+        self._faults: dict[str, SensorFaultParams] = {}
+        self._bias_q: Quat = QUAT_IDENTITY  # δq(β) of an active bias_jump
+
+    # --- faults ------------------------------------------------------------------------
+    @property
+    def outage(self) -> bool:
+        """True while an ``outage`` fault is active (assignable, like ``set_outage``)."""
+        return FAULT_OUTAGE in self._faults
+
+    @outage.setter
+    def outage(self, outage: bool) -> None:
+        self.set_outage(outage)
 
     def set_outage(self, outage: bool) -> None:
         """Start (True) or end (False) an outage: samples are invalid while it lasts."""
-        self.outage = bool(outage)
+        if outage:
+            self.set_fault(FAULT_OUTAGE)
+        else:
+            self.clear_fault(FAULT_OUTAGE)
 
+    @property
+    def faults_active(self) -> dict[str, SensorFaultParams]:
+        """Active faults: kind → parameters (a copy; empty when healthy)."""
+        return {k: dict(v) for k, v in self._faults.items()}
+
+    def set_fault(self, kind: str | None, t_ns: int | None = None, **params: object) -> None:
+        """Inject fault ``kind`` (module docstring) from the next sample, or clear all (None).
+
+        ``t_ns`` is the event time, for the caller's records. Bad kinds or parameters
+        raise ``ConfigError``.
+        """
+        source = f"{SOURCE}.set_fault({kind!r})"
+        if kind is None:
+            if params:
+                key = next(iter(params))
+                raise ConfigError(source, key, params[key], "no parameter when clearing (None)")
+            for k in list(self._faults):
+                self.clear_fault(k, t_ns)
+            return
+        check_fault_kind(kind, params, source, STAR_TRACKER_FAULT_PARAMS)
+        recorded: SensorFaultParams = {}
+        if kind == FAULT_NOISE:
+            factor = check_number(params["factor"], source, "factor", positive=False)
+            recorded["factor"] = factor
+            self._set_noise_factor(factor)
+        elif kind == FAULT_BIAS_JUMP:
+            beta = check_vec3(params["misalignment_arcsec"], source, "misalignment_arcsec")
+            recorded["misalignment_arcsec"] = beta
+            self._bias_q = rotation_vector_quat(
+                (beta[0] * RAD_PER_ARCSEC, beta[1] * RAD_PER_ARCSEC, beta[2] * RAD_PER_ARCSEC)
+            )
+        self._faults[kind] = recorded
+
+    def clear_fault(self, kind: str, t_ns: int | None = None) -> None:
+        """Clear fault ``kind`` from the next sample; a no-op if it is not active."""
+        if kind not in STAR_TRACKER_FAULT_PARAMS:
+            raise ConfigError(
+                f"{SOURCE}.clear_fault({kind!r})",
+                "kind",
+                kind,
+                f"one of {sorted(STAR_TRACKER_FAULT_PARAMS)}",
+            )
+        if self._faults.pop(kind, None) is None:
+            return
+        if kind == FAULT_NOISE:
+            self._set_noise_factor(NOMINAL_NOISE_FACTOR)
+        elif kind == FAULT_BIAS_JUMP:
+            self._bias_q = QUAT_IDENTITY
+
+    def _set_noise_factor(self, factor: float) -> None:
+        p = self.params
+        self._sigma_cross_rad = p.noise_cross_arcsec * RAD_PER_ARCSEC * factor
+        self._sigma_about_rad = p.noise_about_arcsec * RAD_PER_ARCSEC * factor
+
+    # --- sampling ----------------------------------------------------------------------
     def sample(self, t_ns: int, q_BN: Quat) -> tuple[Quat, bool]:
         """(measured q_BN with q0 ≥ 0, valid) at ``t_ns`` for the true attitude ``q_BN``.
 
         The noise is white, so ``t_ns`` only documents when the measurement is taken.
         """
         n1, n2, n3 = self._rng.standard_normal(NORMALS_PER_SAMPLE).tolist()
-        if self.outage:
-            return self._last, False
+        if self._faults:
+            faults = self._faults
+            last = self._last
+            if FAULT_OUTAGE in faults:
+                return (QUAT_IDENTITY if last is None else last), False
+            if FAULT_FROZEN in faults and last is not None:
+                return last, True
+            q_BN = quat_multiply(q_BN, self._bias_q)
         (e1x, e1y, e1z), (e2x, e2y, e2z), (bx, by, bz) = self._axes
         a1 = self._sigma_cross_rad * n1
         a2 = self._sigma_cross_rad * n2
@@ -130,7 +249,7 @@ class StarTracker:
         ty = a1 * e1y + a2 * e2y + a3 * by
         tz = a1 * e1z + a2 * e2z + a3 * bz
         angle = math.sqrt(tx * tx + ty * ty + tz * tz)
-        if angle < SMALL_ANGLE_RAD:
+        if angle < SMALL_ANGLE_RAD:  # δq inline (see rotation_vector_quat): hot path
             dq: Quat = (1.0, 0.5 * tx, 0.5 * ty, 0.5 * tz)
         else:
             s = math.sin(0.5 * angle) / angle

@@ -31,8 +31,9 @@ Physical model (first-order valve dynamics with transport delays)
     Below ``THRUST_CUTOFF_FRACTION``·Fmax a decaying thrust is exactly 0 and, once no
     rise is pending, the valve is idle (``idle_from_ns``). Each command re-plans this
     piecewise-exponential future as a short list of segments, so ``thrust_N`` is a
-    lookup plus one ``exp``. Valid for any t ≥ the previous command's time (so a caller
-    may deliver a command inside an integration step and still sample the step's start).
+    lookup plus one ``exp``. Valid for any t ≥ min(previous event, newest event −
+    ``HISTORY_NS``), events being commands and fault changes (so a caller may deliver
+    commands and faults inside an integration step and still sample the step's start).
 
     Closed-form impulse of an isolated pulse from rest (``Valve.pulse_impulse_Ns``), with
     D = max(0, on + close_delay − open_delay):
@@ -105,6 +106,9 @@ THRUST_CUTOFF_FRACTION = 1e-9
 """A decaying thrust below this fraction of Fmax is exactly zero (the valve is idle)."""
 OPEN_THRESHOLD_FRACTION = 0.1
 """``status`` reports the valve open while the thrust exceeds this fraction of Fmax."""
+HISTORY_NS = 10_000_000
+"""Thrust history kept before the newest event [ns] (10 plant steps at 1 kHz), so that a
+step may be sampled from its start after several events inside it (commands, faults)."""
 NEVER_NS = 2**63 - 1
 """A time later than any simulation (idle_from_ns of a valve that never stops)."""
 FAULT_STUCK_CLOSED = "stuck_closed"
@@ -337,7 +341,7 @@ class Valve:
 
     # --- queries --------------------------------------------------------------------
     def thrust_N(self, t_ns: int) -> float:
-        """Physical thrust [N] at ``t_ns`` (any t ≥ the previous command's time)."""
+        """Physical thrust [N] at ``t_ns`` (any t within the kept history, module docstring)."""
         if t_ns >= self.idle_from_ns:
             return 0.0
         t0, f0, target, k = self._segments[-1]
@@ -454,15 +458,15 @@ class Valve:
             self._event(t_ns, {k: None for k in self._faults})
             return
         recorded = check_fault_params(kind, params, source, self.params.max_thrust_N)
+        rng: np.random.Generator | None = None
         if kind == FAULT_INTERMITTENT:
-            rng = params.get("rng", self._rng)
-            if rng is None:
+            given = params.get("rng", self._rng)
+            if not isinstance(given, np.random.Generator):
                 raise ConfigError(
-                    source, "rng", None, "a numpy Generator (to set_fault or to Valve())"
+                    source, "rng", given, "a numpy Generator (to set_fault or to Valve())"
                 )
-            self._event(t_ns, {kind: recorded}, rng)  # type: ignore[arg-type]
-        else:
-            self._event(t_ns, {kind: recorded})
+            rng = given
+        self._event(t_ns, {kind: recorded}, rng)
 
     def clear_fault(self, kind: str, t_ns: int | None = None) -> None:
         """Clear fault ``kind`` at ``t_ns`` (default as ``set_fault``); a no-op if inactive."""
@@ -596,8 +600,9 @@ class Valve:
             drive_now = drive_now or driven_before
             edges = [] if drive_now else [e for e in edges if e[1]][:1]
 
-        # Keep the segments needed for t in [previous event, t_ns), then plan from t_ns.
-        keep_from = self._last_event_ns
+        # Keep the segments needed for t in [min(previous event, t_ns − history), t_ns),
+        # then plan from t_ns.
+        keep_from = min(self._last_event_ns, t_ns - HISTORY_NS)
         old = self._segments
         first = 0
         for i in range(len(old) - 1, -1, -1):

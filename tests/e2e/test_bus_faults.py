@@ -104,7 +104,7 @@ def test_frame_faults_have_their_counted_effects(tmp_path: Path, runtime_dir: Pa
     assert frames["IMU_RATE"]["gaps"] == eff["dropped"]  # the receiver sees them as gaps
     assert frames["STR_QUAT"]["rejected"] == {"crc": eff["corrupted"]} and eff["corrupted"] > 0
     assert frames["THR_CMD_0"]["rejected"] == {"counter": eff["duplicated"]}
-    assert frames["0x001"]["rejected"] == {"unknown_id": eff["babbled"]}
+    assert s["rejected_other"]["FSW"] == {"unknown_id": eff["babbled"]}
     assert s["deadline_misses"]["stalls"] == 0
 
 
