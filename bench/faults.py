@@ -5,6 +5,13 @@ end of the run), a ``kind`` and its target and parameters:
 
 - ``stuck_closed`` (``thruster``): the valve never opens (bench/valves).
 - ``stuck_open`` (``thruster``): the valve opens and stays open (bench/valves).
+- ``degraded`` (``thruster``; ``factor`` in [0, 1]), ``delayed`` (``extra_delay_s``),
+  ``intermittent`` (``dropout_probability`` per pulse), ``leak`` (``thrust_N``),
+  ``misaligned`` (``angle_deg``, ``axis_B``): see bench/valves/valve.py and thruster_set.py.
+- Sensor faults (``sensor`` = ``gyro``, ``accelerometer`` or ``star_tracker``):
+  ``bias_jump`` (``jump_rad_s`` [3] for the gyro, ``jump_m_s2`` [3] for the accelerometer,
+  ``misalignment_arcsec`` [3] for the star tracker), ``frozen`` (same output, counter still
+  advancing), ``outage`` (frames marked invalid), ``noise`` (``factor`` on the white noise).
 - ``link_error`` (``message`` or ``node``; ``probability`` in (0, 1]): each matching frame
   fails once on the wire with that probability: error frame, then retransmission after
   re-arbitration (bench/bus/timing).
@@ -32,12 +39,24 @@ from typing import Any
 
 from dbc.schema import Table
 
-THRUSTER_KINDS = ("stuck_closed", "stuck_open")
+THRUSTER_KINDS = ("stuck_closed", "stuck_open", "degraded", "delayed", "intermittent", "leak",
+                  "misaligned")
+THRUSTER_PARAMS: dict[str, tuple[tuple[str, float, float], ...]] = {  # (name, lo, hi)
+    "degraded": (("factor", 0.0, 1.0),),
+    "delayed": (("extra_delay_s", 0.0, 1.0),),
+    "intermittent": (("dropout_probability", 0.0, 1.0),),
+    "leak": (("thrust_N", 0.0, 1e3),),
+    "misaligned": (("angle_deg", -180.0, 180.0),),
+}
+SENSORS = ("gyro", "accelerometer", "star_tracker")
+SENSOR_KINDS = ("bias_jump", "frozen", "outage", "noise")
+BIAS_JUMP_PARAM = {"gyro": "jump_rad_s", "accelerometer": "jump_m_s2",
+                   "star_tracker": "misalignment_arcsec"}
 FRAME_KINDS = ("link_error", "drop", "delay", "corrupt", "duplicate")
 BUS_KINDS = (*FRAME_KINDS, "bus_off", "babbling")
 MAX_STD_ID = 0x7FF
 MAX_RATE_HZ = 20_000.0  # above a 1 Mbit/s bus's capacity for 8-byte frames
-FAULT_KINDS = THRUSTER_KINDS + BUS_KINDS
+FAULT_KINDS = THRUSTER_KINDS + BUS_KINDS + SENSOR_KINDS
 
 
 @dataclass(frozen=True)
@@ -50,12 +69,13 @@ class FaultSpec:
     thruster: int | None = None
     message: str | None = None
     node: str | None = None
-    params: dict[str, float] = field(default_factory=dict)
+    sensor: str | None = None
+    params: dict[str, Any] = field(default_factory=dict)
 
     def record(self) -> dict[str, Any]:
         """Plain-dict form for summary.json and events.jsonl."""
         out: dict[str, Any] = {"t_s": self.t_s, "kind": self.kind, "duration_s": self.duration_s}
-        for key in ("thruster", "message", "node"):
+        for key in ("thruster", "message", "node", "sensor"):
             if getattr(self, key) is not None:
                 out[key] = getattr(self, key)
         out.update(self.params)
@@ -118,7 +138,20 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
             k = f.integer("thruster", lo=0)
             if k >= n_thrusters:
                 raise f.error("thruster", k, f"a thruster index 0..{n_thrusters - 1}")
-            spec = FaultSpec(t_s, kind, dur, thruster=k)
+            params: dict[str, Any] = {
+                name: f.number(name, lo=lo, hi=hi) for name, lo, hi in THRUSTER_PARAMS.get(kind, ())
+            }
+            if kind == "misaligned":
+                params["axis_B"] = f.vector3("axis_B")
+            spec = FaultSpec(t_s, kind, dur, thruster=k, params=params)
+        elif kind in SENSOR_KINDS:
+            sensor = f.string("sensor", choices=SENSORS)
+            params = {}
+            if kind == "bias_jump":
+                params[BIAS_JUMP_PARAM[sensor]] = f.vector3(BIAS_JUMP_PARAM[sensor])
+            elif kind == "noise":
+                params["factor"] = f.number("factor", lo=0.0)
+            spec = FaultSpec(t_s, kind, dur, sensor=sensor, params=params)
         elif kind in FRAME_KINDS:
             message = (f.string("message", choices=tuple(sorted(messages)))
                        if f.has("message") else None)

@@ -266,11 +266,11 @@ class BenchNode:
         p = self.plant
         s = p.state
         if name == "IMU_RATE":
-            w = p.gyro.sample(t_ns, (s[4], s[5], s[6]))
-            return {"Valid": 1, "RateX": w[0], "RateY": w[1], "RateZ": w[2]}
+            w, ok = p.gyro.measure(t_ns, (s[4], s[5], s[6]))
+            return {"Valid": int(ok), "RateX": w[0], "RateY": w[1], "RateZ": w[2]}
         if name == "IMU_ACCEL":
-            a = p.accel.sample(t_ns, p.specific_force_B())
-            return {"Valid": 1, "AccelX": a[0], "AccelY": a[1], "AccelZ": a[2]}
+            a, ok = p.accel.measure(t_ns, p.specific_force_B())
+            return {"Valid": int(ok), "AccelX": a[0], "AccelY": a[1], "AccelZ": a[2]}
         if name == "STR_QUAT":
             q, valid = p.star.sample(t_ns, (s[0], s[1], s[2], s[3]))
             return {"Valid": int(valid), **pack_quaternion(q)}
@@ -322,10 +322,8 @@ class BenchNode:
             self._start_fault(f, t_ns, end)
         for item in [x for x in self.active_faults if x[1] is not None and x[1] <= t_ns]:
             self.active_faults.remove(item)
-            f = item[0]
-            if f.thruster is not None:
-                self.plant.thrusters.set_fault(f.thruster, None, t_ns)
-            self.trace.event(t_ns, "fault_cleared", **f.record())
+            self._end_fault(item[0], t_ns)
+            self.trace.event(t_ns, "fault_cleared", **item[0].record())
 
     def _start_fault(self, f: FaultSpec, t_ns: int, end_ns: int | None,
                      source: str = "scenario") -> None:
@@ -334,7 +332,9 @@ class BenchNode:
             rec["applied"] = False
             rec["why"] = "bus faults act on the modelled bus (lockstep runs only)"
         elif f.thruster is not None:
-            self.plant.thrusters.set_fault(f.thruster, f.kind, t_ns)
+            self.plant.thrusters.set_fault(f.thruster, f.kind, t_ns, **f.params)
+        elif f.sensor is not None:
+            self._sensor(f.sensor).set_fault(f.kind, t_ns, **f.params)
         elif f.kind == "bus_off" and f.node is not None:
             until = self.arbiter.bus_off(f.node, t_ns, end_ns)
             rec["until_s"] = until / NS_PER_S
@@ -342,6 +342,17 @@ class BenchNode:
         self.active_faults.append((f, end_ns))
         self.faults_log.append(rec)
         self.trace.event(t_ns, "fault_injected", **rec)
+
+    def _sensor(self, name: str) -> Any:
+        return {"gyro": self.plant.gyro, "accelerometer": self.plant.accel,
+                "star_tracker": self.plant.star}[name]
+
+    def _end_fault(self, f: FaultSpec, t_ns: int) -> None:
+        """Undo the physical effect of ``f`` (bus faults just stop matching frames)."""
+        if f.thruster is not None:
+            self.plant.thrusters.clear_fault(f.thruster, f.kind, t_ns)
+        elif f.sensor is not None:
+            self._sensor(f.sensor).clear_fault(f.kind, t_ns)
 
     @property
     def active_faults_specs(self) -> list[FaultSpec]:
@@ -514,8 +525,7 @@ class BenchNode:
         if int(s["Action"]) == 0:
             for item in [x for x in self.active_faults if _same_target(x[0], spec)]:
                 self.active_faults.remove(item)
-                if item[0].thruster is not None:
-                    self.plant.thrusters.set_fault(item[0].thruster, None, t)
+                self._end_fault(item[0], t)
                 self.trace.event(t, "fault_cleared", **item[0].record(), source="FAULT_CMD")
             return
         end = t + round(spec.duration_s * NS_PER_S) if spec.duration_s > 0 else None
