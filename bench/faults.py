@@ -178,8 +178,14 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
 
 # FAULT_CMD.FaultType values (the DBC's VAL_ table) this bench acts on, and FAULT_CMD.Target
 # node indices for node faults.
-FAULT_CMD_KINDS = {1: "stuck_closed", 2: "stuck_open", 8: "drop", 9: "delay", 10: "corrupt",
-                   11: "duplicate", 12: "babbling", 13: "bus_off", 14: "link_error"}
+FAULT_CMD_KINDS = {1: "stuck_closed", 2: "stuck_open", 3: "degraded", 4: "misaligned",
+                   5: "delayed", 6: "intermittent", 7: "leak", 8: "drop", 9: "delay",
+                   10: "corrupt", 11: "duplicate", 12: "babbling", 13: "bus_off",
+                   14: "link_error", 15: "bias_jump", 16: "frozen", 17: "outage", 18: "noise"}
+# the single Param of a FAULT_CMD, per kind that takes one
+FAULT_CMD_PARAM = {"degraded": "factor", "misaligned": "angle_deg", "delayed": "extra_delay_s",
+                   "intermittent": "dropout_probability", "leak": "thrust_N", "noise": "factor"}
+FAULT_CMD_AXIS_B = (0.0, 0.0, 1.0)  # misalignment axis of a FAULT_CMD (not encodable)
 FAULT_CMD_NODES = ("BENCH", "FSW")
 KHZ = 1000.0
 
@@ -188,9 +194,11 @@ def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thr
                        t_s: float) -> FaultSpec | None:
     """The fault a FAULT_CMD frame describes (see its DBC comments), or None if unsupported.
 
-    Target is a thruster index (thruster kinds), the CAN ID of a message (frame kinds), the
-    CAN ID to babble with (babbling), or a node index (bus_off). Param is the probability
-    (frame kinds), the delay in seconds (delay) or the rate in kHz (babbling).
+    Target is a thruster index (thruster kinds), a sensor index (0 gyro, 1 accelerometer,
+    2 star tracker), the CAN ID of a message (frame kinds), the CAN ID to babble with
+    (babbling), or a node index (bus_off). Param is the kind's one parameter: factor,
+    angle (deg, about z_B), extra delay (s), dropout probability, leak thrust (N), bias jump
+    on the sensor's x axis, probability (frame kinds), delay (s) or rate (kHz, babbling).
     """
     kind = FAULT_CMD_KINDS.get(int(signals["FaultType"]))
     target, param = int(signals["Target"]), float(signals["Param"])
@@ -198,7 +206,24 @@ def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thr
     if kind is None:
         return None
     if kind in THRUSTER_KINDS:
-        return FaultSpec(t_s, kind, dur, thruster=target) if target < n_thrusters else None
+        if target >= n_thrusters:
+            return None
+        params: dict[str, Any] = {}
+        if kind in FAULT_CMD_PARAM:
+            params[FAULT_CMD_PARAM[kind]] = param
+        if kind == "misaligned":
+            params["axis_B"] = FAULT_CMD_AXIS_B
+        return FaultSpec(t_s, kind, dur, thruster=target, params=params)
+    if kind in SENSOR_KINDS:
+        if target >= len(SENSORS):
+            return None
+        sensor = SENSORS[target]
+        params = {}
+        if kind == "noise":
+            params["factor"] = param
+        elif kind == "bias_jump":  # Param on the sensor's x axis, in its units
+            params[BIAS_JUMP_PARAM[sensor]] = (param, 0.0, 0.0)
+        return FaultSpec(t_s, kind, dur, sensor=sensor, params=params)
     if kind == "bus_off":
         return (FaultSpec(t_s, kind, dur, node=FAULT_CMD_NODES[target])
                 if target < len(FAULT_CMD_NODES) else None)

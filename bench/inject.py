@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import can
 
+from bench.faults import FAULT_CMD_KINDS
 from dbc import e2e, load_database
 from dbc.bus import open_bus
 from dbc.codec import Encoder, FrameChecker
@@ -21,8 +22,7 @@ from dbc.errors import RunError
 
 COUNTER_NONE = 15
 DEFAULT_TIMEOUT_S = 5.0
-KIND_CODES = {"stuck_closed": 1, "stuck_open": 2, "drop": 8, "delay": 9, "corrupt": 10,
-              "duplicate": 11, "babbling": 12, "bus_off": 13, "link_error": 14}
+KIND_CODES = {kind: code for code, kind in FAULT_CMD_KINDS.items()}
 
 
 @dataclass(frozen=True)
