@@ -53,9 +53,10 @@ RAD_DEG = 180.0 / math.pi
 TELEMETRY_PERIOD_NS = 10_000_000
 SENSOR_ORDER = ("IMU_RATE", "IMU_ACCEL", "STR_QUAT", "NAV_POS", "NAV_VEL", "THR_STATUS",
                 "BENCH_STATUS")
-FSW_FRAMES = frozenset(
-    {"THR_CMD_0", "THR_CMD_1", "THR_CMD_2", "THR_CMD_3", "FSW_STATUS", "FSW_ATT_EST", "FAULT_CMD"}
-)
+FSW_FRAMES = frozenset({"THR_CMD_0", "THR_CMD_1", "THR_CMD_2", "THR_CMD_3", "FSW_STATUS",
+                        "FSW_ATT_EST", "FSW_FDIR", "FAULT_CMD"})
+NO_FAILED_THRUSTER = 31  # FSW_FDIR.FailedThruster: none isolated
+FAILURE_KINDS = {0: "none", 1: "stuck_closed", 2: "stuck_open", 3: "other"}
 NAV_POS_MAX_M = 32.767  # NAV_POS range in the DBC
 NAV_VEL_MAX_M_S = 3.2767  # NAV_VEL range in the DBC
 HEALTH_WATCHDOG = 0x1
@@ -198,6 +199,7 @@ class BenchNode:
         self.active_faults: list[tuple[FaultSpec, int | None]] = []
         self.delayed: list[tuple[int, can.Message, str]] = []
         self.fault_cmd_counter = FAULT_CMD_NONE
+        self.fdir: dict[str, Any] = {}
         self.fault_counts: dict[str, int] = {
             k: 0 for k in ("dropped", "delayed", "corrupted", "duplicated", "babbled")}
         self.fault_rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
@@ -505,6 +507,8 @@ class BenchNode:
     def _on_fsw_frame(self, d_name: str, s: dict[str, float], counter: int = 0) -> None:
         if d_name == "FAULT_CMD":
             self._on_fault_cmd(s, counter)
+        elif d_name == "FSW_FDIR":
+            self._on_fdir(s)
         elif d_name == "FSW_STATUS":
             self.fsw_status = s
         elif d_name == "FSW_ATT_EST":
@@ -512,6 +516,21 @@ class BenchNode:
             # the estimate is of the cycle's time t_k, which is where the plant is now (lockstep)
             self.fsw_est_err_deg = quat_error_deg(self.plant.state[0:4], self.fsw_q_est)
             self.fsw_q_valid = bool(s["Valid"])
+
+    def _on_fdir(self, s: dict[str, float]) -> None:
+        """Keep the flight software's latest FDIR report and record its first isolation."""
+        failed = int(s["FailedThruster"])
+        report = {
+            "available_mask": int(s["AvailableMask"]),
+            "failed_thruster": None if failed == NO_FAILED_THRUSTER else failed,
+            "failure_kind": FAILURE_KINDS.get(int(s["FailureKind"]), "other"),
+            "detection_time_s": float(s["DetectionTime"]) or None,
+            "isolation_delay_s": float(s["IsolationDelay"]),
+            "sensor_flags": int(s["SensorFlags"]),
+        }
+        if report["failed_thruster"] is not None and self.fdir.get("failed_thruster") is None:
+            self.trace.event(self.plant.t_ns, "fsw_isolated", **report)
+        self.fdir = report
 
     def _on_fault_cmd(self, s: dict[str, float], counter: int) -> None:
         """A live FAULT_CMD: inject or clear, acknowledged in BENCH_STATUS.FaultCmdCounter."""
@@ -819,6 +838,7 @@ class BenchNode:
             "valve_watchdog_trips": self.watchdog_trips,
             "faults": self.faults_log,
             "fault_effects": dict(self.fault_counts),
+            "fdir": self.fdir,
             "expectations": exps,
             "passed": all(x["pass"] for x in exps) and pm.converged,
         }
