@@ -825,6 +825,7 @@ class BenchNode:
             "steady_state_attitude_error_deg": pm.steady_state_attitude_error_deg,
             "steady_state_rate_error_deg_s": pm.steady_state_rate_error_deg_s,
             "final_attitude_error_deg": pm.final_attitude_error_deg,
+            "final_position_error_m": math.dist(self.plant.state[7:10], sc.r0_N_m),
             "propellant_kg": thr.total_propellant_kg,
             "valve_openings": {"total": int(sum(thr.openings)), "per_thruster": list(thr.openings)},
             "frames": frames,
