@@ -1,0 +1,141 @@
+"""Single-failure campaign: every thruster stuck closed, then stuck open, one lockstep run each.
+
+``python -m bench.campaign SCENARIO --out DIR [--fault-time S] [--jobs N] [--kinds ...]``
+(also ``thruster-hil campaign``). Each run is the scenario with one ``[[faults]]`` entry
+appended, started as its own ``thruster-hil run`` process on a private portable-bus channel,
+``--jobs`` at a time. The flight software's FDIR report (FSW_FDIR, in each summary.json)
+gives detection and isolation. Out, in DIR: ``campaign.csv`` (one row per run: thruster,
+kind, detected, detection time after the fault, isolated thruster, isolation correct,
+expectations met, final attitude and position error, propellant), ``campaign.json`` and
+``campaign.png`` (detection time per thruster and kind), plus every run folder.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import uuid
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from bench.scenario import load_scenario  # noqa: E402
+
+KINDS = ("stuck_closed", "stuck_open")
+COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruster",
+           "isolation_correct", "expectations_met", "final_attitude_error_deg",
+           "final_position_error_m", "propellant_kg", "run_dir"]
+DPI = 110
+
+
+def _run_one(scenario: Path, fault: str, out: Path, xdg: Path) -> dict[str, Any]:
+    out.mkdir(parents=True, exist_ok=True)
+    text = scenario.read_text(encoding="utf-8").rstrip() + "\n" + fault
+    sc_file = out / "campaign_scenario.toml"
+    sc_file.write_text(text, encoding="utf-8")
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
+    subprocess.run(
+        [sys.executable, "-m", "bench.cli", "run", str(sc_file), "--bus",
+         f"hilbus:c{uuid.uuid4().hex[:10]}", "--out", str(out / "run")],
+        env=env, capture_output=True, check=False,
+    )
+    return json.loads((out / "run" / "summary.json").read_text(encoding="utf-8"))
+
+
+def _row(k: int, kind: str, fault_t_s: float, s: dict[str, Any], run_dir: Path) -> dict[str, Any]:
+    fdir = s.get("fdir") or {}
+    iso = fdir.get("failed_thruster")
+    t_det = fdir.get("detection_time_s")
+    return {
+        "thruster": k, "kind": kind, "detected": iso is not None,
+        "detection_time_s": None if t_det is None else round(t_det - fault_t_s, 3),
+        "isolated_thruster": iso,
+        "isolation_correct": iso == k and fdir.get("failure_kind") == kind,
+        "expectations_met": bool(s.get("passed")),
+        "final_attitude_error_deg": s.get("final_attitude_error_deg"),
+        "final_position_error_m": s.get("final_position_error_m"),
+        "propellant_kg": s.get("propellant_kg"),
+        "run_dir": str(run_dir),
+    }
+
+
+def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
+                 kinds: tuple[str, ...] = KINDS) -> list[dict[str, Any]]:
+    """Run every single-thruster failure of ``kinds``; write the CSV, JSON and PNG."""
+    n = len(load_scenario(scenario).thrusters)
+    out.mkdir(parents=True, exist_ok=True)
+    cases = [(k, kind) for kind in kinds for k in range(n)]
+    with tempfile.TemporaryDirectory(prefix="thil-campaign-") as tmp:
+        xdg = Path(tmp)
+        xdg.chmod(0o700)
+
+        def job(case: tuple[int, str]) -> dict[str, Any]:
+            k, kind = case
+            d = out / f"{kind}_T{k:02d}"
+            fault = f'\n[[faults]]\nt_s = {fault_t_s}\nkind = "{kind}"\nthruster = {k}\n'
+            return _row(k, kind, fault_t_s, _run_one(scenario, fault, d, xdg), d / "run")
+
+        with ThreadPoolExecutor(max_workers=jobs) as pool:
+            rows = list(pool.map(job, cases))
+    with open(out / "campaign.csv", "w", newline="", encoding="utf-8") as f:
+        w = csv.DictWriter(f, fieldnames=COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    (out / "campaign.json").write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+    _plot(rows, out / "campaign.png")
+    return rows
+
+
+def _plot(rows: list[dict[str, Any]], path: Path) -> None:
+    fig, ax = plt.subplots(figsize=(9, 4))
+    width = 0.4
+    for i, kind in enumerate(KINDS):
+        sel = [r for r in rows if r["kind"] == kind]
+        xs = [r["thruster"] + (i - 0.5) * width for r in sel]
+        ys = [r["detection_time_s"] if r["detection_time_s"] is not None else 0.0 for r in sel]
+        bars = ax.bar(xs, ys, width, label=kind)
+        for bar, r in zip(bars, sel, strict=True):
+            if not r["detected"] or not r["isolation_correct"]:
+                bar.set_hatch("//")
+                bar.set_edgecolor("red")
+    ax.set_xlabel("failed thruster")
+    ax.set_ylabel("detection time after the fault [s]")
+    ax.set_title("Single-failure campaign (hatched: not detected or wrongly isolated)")
+    ax.legend()
+    ax.grid(True, axis="y", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line; exit 0 if every run was detected, isolated and met its expectations."""
+    p = argparse.ArgumentParser(prog="thruster-hil campaign", description=__doc__.split("\n")[0])
+    p.add_argument("scenario")
+    p.add_argument("--out", required=True)
+    p.add_argument("--fault-time", type=float, default=10.0, help="fault time [s]")
+    p.add_argument("--jobs", type=int, default=max(1, (os.cpu_count() or 2) // 2))
+    p.add_argument("--kinds", nargs="+", choices=KINDS, default=list(KINDS))
+    args = p.parse_args(argv)
+    rows = run_campaign(Path(args.scenario), Path(args.out), args.fault_time, args.jobs,
+                        tuple(args.kinds))
+    for r in rows:
+        print(f"T{r['thruster']:02d} {r['kind']:12s} detected={r['detected']!s:5} "
+              f"t={r['detection_time_s']} isolated={r['isolated_thruster']} "
+              f"ok={r['isolation_correct']} expectations={r['expectations_met']}")
+    ok = all(r["detected"] and r["isolation_correct"] and r["expectations_met"] for r in rows)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
