@@ -27,9 +27,9 @@ from typing import Any
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from bench.scenario import load_scenario  # noqa: E402
+from bench.scenario import load_scenario
 
 KINDS = ("stuck_closed", "stuck_open")
 COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruster",
