@@ -20,8 +20,8 @@ Where settings come from (first given wins): the keyword argument, the command-l
 option, the scenario (seed, duration) or the default. Command-line options:
 
 * ``--hil-bus SPEC``: the bus (default: a private portable bus per run, ``hilbus:`` in a
-  private ``XDG_RUNTIME_DIR`` under pytest's temporary directory, so parallel sessions
-  never meet); e.g. ``--hil-bus socketcan:can0`` for real hardware.
+  private, owner-only ``XDG_RUNTIME_DIR`` of the session, so parallel sessions never
+  meet); e.g. ``--hil-bus socketcan:can0`` for real hardware.
 * ``--hil-mode lockstep|realtime`` (default lockstep: modelled bus times, deterministic).
 * ``--hil-fsw-cmd CMD``: the flight-software command (placeholders as for
   ``thruster-hil run --fsw-cmd``); ``none`` runs the bench alone, for flight software on
@@ -40,11 +40,13 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
+import tempfile
 import uuid
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -64,8 +66,8 @@ MODES = ("lockstep", "realtime")
 DEFAULT_MODE = "lockstep"
 NO_FSW = "none"  # --hil-fsw-cmd none: the bench alone
 PRIVATE_CHANNEL_PREFIX = "hil"
-PRIVATE_CHANNEL_HEX = 10
-PRIVATE_DIR_MODE = 0o700
+PRIVATE_CHANNEL_HEX = 8
+PRIVATE_DIR_PREFIX = "thil-"
 XDG = "XDG_RUNTIME_DIR"
 SOURCE = "hil_run"
 
@@ -253,10 +255,14 @@ class _Session:
 
     @property
     def private_runtime_dir(self) -> Path:
-        """An owner-only runtime directory for the private portable buses."""
+        """An owner-only runtime directory for the private portable buses.
+
+        A short path in the system temporary directory (not under ``--basetemp``): Unix
+        socket paths are limited to about 107 bytes. Removed at the end of the session.
+        """
         if self._xdg is None:
-            self._xdg = self.tmp.mktemp("hil_xdg")
-            self._xdg.chmod(PRIVATE_DIR_MODE)
+            self._xdg = Path(tempfile.mkdtemp(prefix=PRIVATE_DIR_PREFIX))  # mode 0o700
+            self.config.add_cleanup(partial(shutil.rmtree, self._xdg, ignore_errors=True))
         return self._xdg
 
 
@@ -323,8 +329,10 @@ class HilRunner:
         if opts.mode != "lockstep" or fresh or opts not in s.runs:
             run_dir, summary, used_bus = self._run(opts)
             run = HilRun(run_dir, summary, opts, used_bus, timing)
-            if opts.mode == "lockstep":
+            if opts.mode == "lockstep":  # the newest run of these options is the shared one
                 s.runs[opts] = (run_dir, summary, used_bus)
+                for key in [k for k in s.views if k[0] == opts]:
+                    del s.views[key]
                 s.views[(opts, timing)] = run
             return run
         if (opts, timing) not in s.views:

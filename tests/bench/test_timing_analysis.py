@@ -333,7 +333,7 @@ def test_bus_load_realtime_places_bits_at_arrival(tmp_path: Path) -> None:
 
 
 def test_rta_bound_and_flag(tmp_path: Path) -> None:
-    """SYNC (highest priority, 8 bytes) at 1 Mbit/s: bound B + C = 135 + 135 us; 300 us flags."""
+    """SYNC at 1 Mbit/s, top priority: R = B + C = 135 + 135 us (8-byte frames); 300 us flags."""
     ok = _periodic(SYNC, CMD_PERIOD_S, 5, 200 * US)
     rt = RunTiming.load(_write_run(tmp_path / "ok", ok))
     assert rt.message("SYNC").bound_us == pytest.approx(270, abs=TIME_TOL_US)
@@ -474,3 +474,26 @@ def test_live_options_validation() -> None:
         LiveOptions(duration_s=0.0)
     with pytest.raises(ConfigError, match="bitrate_bps"):
         LiveOptions(duration_s=1.0, bitrate_bps=-5)
+
+
+# -- command line ------------------------------------------------------------------------
+
+
+def test_cli_timing_strict_exit_and_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`timing DIR --json --strict`: JSON on stdout, files written, exit 1 only when flagged."""
+    from bench.cli import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, main
+
+    ok = _write_run(tmp_path / "ok", _periodic(SYNC, CMD_PERIOD_S, 5, 200 * US))
+    assert main(["timing", str(ok), "--json", "--strict"]) == EXIT_OK
+    assert json.loads(capsys.readouterr().out)["flags"] == []
+    assert (ok / "timing.json").is_file() and (ok / "latency_hist.png").is_file()
+    bad_rows = _periodic(SYNC, CMD_PERIOD_S, 5, 200 * US)
+    bad_rows[2][2] = bad_rows[2][0] + 300 * US  # above the 270 us bound
+    bad = _write_run(tmp_path / "bad", bad_rows)
+    assert main(["timing", str(bad), "--strict"]) == EXIT_FAILED
+    assert "FLAG" in capsys.readouterr().out
+    assert main(["timing", str(bad)]) == EXIT_OK
+    assert main(["timing", str(ok), "--window-ms", "0"]) == EXIT_BAD_INPUT
+    assert main(["timing"]) == EXIT_BAD_INPUT
