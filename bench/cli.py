@@ -74,7 +74,7 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
     from bench.orchestrator import DEFAULT_FSW_CMD, RunOptions, run_scenario
     from bench.scenario import load_scenario
 
-    sc = load_scenario(args.scenario)
+    sc = load_scenario(args.scenario, args.overrides)
     bus = args.bus or default_bus_spec()
     BusSpec.parse(bus)
     opts = RunOptions(
@@ -183,6 +183,10 @@ def build_parser() -> argparse.ArgumentParser:
         r.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
         r.add_argument("--out", help="run folder (default: runs/<scenario>-<time>)")
         r.add_argument("--duration", type=float, help="override the scenario duration [s]")
+        r.add_argument("--set", dest="overrides", action="append", default=[],
+                       metavar="KEY=VALUE",
+                       help="override a scenario value, e.g. --set bus.bitrate_bps=125000 "
+                       "(repeatable; TOML values)")
         if name == "run":
             r.add_argument(
                 "--fsw-cmd",
@@ -192,7 +196,48 @@ def build_parser() -> argparse.ArgumentParser:
     rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
     rp.add_argument("run_dir")
     _add_timing_parser(sub)
+    inj = sub.add_parser("inject", help="inject or clear a fault live on a running bench "
+                         "(a FAULT_CMD frame, acknowledged by the bench)")
+    inj.add_argument("kind", help="fault kind, e.g. stuck_open, degraded, drop, bus_off, outage")
+    inj.add_argument("--bus", help="bus spec of the running bench")
+    inj.add_argument("--target", type=lambda x: int(x, 0), required=True,
+                     help="thruster index, sensor index (0 gyro, 1 accelerometer, 2 star "
+                     "tracker), message CAN ID (e.g. 0x40) or node index (0 BENCH, 1 FSW)")
+    inj.add_argument("--duration", type=float, default=0.0, help="seconds; 0 = until cleared")
+    inj.add_argument("--param", type=float, default=0.0,
+                     help="the kind's parameter (factor, probability, delay s, ...)")
+    inj.add_argument("--clear", action="store_true", help="clear the fault instead")
+    inj.add_argument("--print-frame", type=int, metavar="COUNTER",
+                     help="only print the frame for cansend, with this alive counter")
+    cp = sub.add_parser("campaign", help="every single-thruster stuck_closed / stuck_open "
+                        "failure of a scenario, one lockstep run each; CSV + PNG")
+    cp.add_argument("scenario")
+    cp.add_argument("--out", required=True)
+    cp.add_argument("--fault-time", type=float, default=10.0)
+    cp.add_argument("--jobs", type=int, default=1)
+    cp.add_argument("--kinds", nargs="+", default=["stuck_closed", "stuck_open"])
     return p
+
+
+def _cmd_inject(args: argparse.Namespace) -> int:
+    from bench.inject import FaultCommand, cansend_string, inject
+
+    cmd = FaultCommand(args.kind, args.target, args.duration, args.param, args.clear)
+    if args.print_frame is not None:
+        print(cansend_string(cmd, args.print_frame))
+        return EXIT_OK
+    bus = args.bus or default_bus_spec()
+    counter = inject(bus, cmd)
+    print(f"{'cleared' if args.clear else 'injected'} {args.kind} target {args.target} on {bus} "
+          f"(acknowledged, counter {counter})")
+    return EXIT_OK
+
+
+def _cmd_campaign(args: argparse.Namespace) -> int:
+    from bench.campaign import main as campaign_main
+
+    return campaign_main([args.scenario, "--out", args.out, "--fault-time", str(args.fault_time),
+                          "--jobs", str(args.jobs), "--kinds", *args.kinds])
 
 
 def _add_timing_parser(sub: Any) -> None:
@@ -269,6 +314,10 @@ def main(argv: list[str] | None = None) -> int:
             return _cmd_report(args)
         if args.command == "timing":
             return _cmd_timing(args)
+        if args.command == "inject":
+            return _cmd_inject(args)
+        if args.command == "campaign":
+            return _cmd_campaign(args)
         return _cmd_run(args, alone=args.command == "bench")
     except (ConfigError, BusError) as exc:
         print(f"thruster-hil: error: {exc}", file=sys.stderr)

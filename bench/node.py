@@ -213,6 +213,7 @@ class BenchNode:
         self.fsw_alive: Callable[[], bool] | None = None
         self._wire_pending: dict[int, tuple[can.Message, bool, int]] = {}
         self.last_sync_ns = 0  # lockstep: time of the run's last SYNC
+        self._last_rx_ns = 0  # latest reception on the modelled wire
 
     # -- telemetry ---------------------------------------------------------------
     def _columns(self) -> list[str]:
@@ -496,6 +497,7 @@ class BenchNode:
             self.trace.frame(msg, t_rx, tx=tx, t_ready_ns=d.ready_ns, t_start_ns=d.start_ns,
                              bits=bits)
             rx[d.seq] = t_rx
+            self._last_rx_ns = max(self._last_rx_ns, t_rx)
         return rx
 
     def _send_queue(self, realtime_ns: int | None = None) -> None:
@@ -611,8 +613,13 @@ class BenchNode:
         for k in range(n_cycles):
             t_k = k * self.period_ns
             self._send_queue()
-            self._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S}, t_k)
-            self._collect_lockstep(k, t_k + delay_ns)
+            # SYNC closes the samples of (t_{k-1}, t_k]: it is queued once they are through,
+            # and the flight software's cycle starts when SYNC has arrived.
+            self._flush_wire()
+            self._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S},
+                       max(t_k, self._last_rx_ns))
+            self._flush_wire()
+            self._collect_lockstep(k, self._last_rx_ns + delay_ns)
             self.integrate_to(t_k + self.period_ns)
             if k % 5 == 0:
                 self.trace.flush()
@@ -812,6 +819,7 @@ class BenchNode:
         return {
             "scenario": sc.name,
             "scenario_file": sc.path,
+            "overrides": list(sc.overrides),
             "mode": self.mode,
             "seed": self.seed,
             "bus": self.bus_spec,

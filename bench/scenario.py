@@ -13,6 +13,7 @@ radians here; quaternions are scalar-first q_BN.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from dataclasses import dataclass, field
@@ -137,6 +138,7 @@ class Scenario:
     faults: tuple[FaultSpec, ...]
     expectations: Expectations
     raw: dict[str, Any] = field(repr=False, compare=False, default_factory=dict)
+    overrides: tuple[str, ...] = ()
 
     def fsw_config(self) -> dict[str, Any]:
         """The flight-software configuration file content (nominal vehicle + [flight_sw])."""
@@ -411,4 +413,4 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(str(p), "<syntax>", str(exc), "valid TOML") from exc
     apply_overrides(data, overrides or [], str(p))
-    return parse_scenario(data, str(p))
+    return dataclasses.replace(parse_scenario(data, str(p)), overrides=tuple(overrides or ()))
