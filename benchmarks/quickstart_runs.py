@@ -27,11 +27,11 @@ REPO = Path(__file__).resolve().parents[1]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
 
 
-def _run(extra: list[str], scratch: Path) -> dict[str, Any]:
+def _run(extra: list[str], scratch: Path, bus: str | None = None) -> dict[str, Any]:
     out = scratch / uuid.uuid4().hex[:8]
     xdg = Path(tempfile.mkdtemp(prefix="xdg-", dir=scratch))
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
-    bus = f"hilbus:bm{uuid.uuid4().hex[:8]}"
+    bus = bus or f"hilbus:bm{uuid.uuid4().hex[:8]}"
     subprocess.run(
         [sys.executable, "-m", "bench.cli", "run", str(QUICKSTART), "--bus", bus,
          "--out", str(out), *extra],
@@ -46,6 +46,9 @@ def main() -> None:
     p.add_argument("--runs", type=int, default=3, help="lockstep runs (default 3)")
     p.add_argument("--realtime-s", type=float, default=0.0,
                    help="also one realtime run of this many seconds (0: none)")
+    p.add_argument("--realtime-bus", default=None,
+                   help="bus of the realtime run (default: a private portable bus; "
+                   "e.g. socketcan:vcan0 inside the CI guest)")
     args = p.parse_args()
     with tempfile.TemporaryDirectory(prefix="thil-bench-") as tmp:
         scratch = Path(tmp)
@@ -66,8 +69,10 @@ def main() -> None:
             },
         }
         if args.realtime_s > 0:
-            rt = _run(["--mode", "realtime", "--duration", str(args.realtime_s)], scratch)
+            rt = _run(["--mode", "realtime", "--duration", str(args.realtime_s)], scratch,
+                      args.realtime_bus)
             result["realtime"] = {
+                "bus": rt["bus"],
                 "sim_time_s": rt["sim_time_s"],
                 "converged": rt["converged"],
                 "settling_time_s": rt["settling_time_s"],
