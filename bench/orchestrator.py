@@ -14,6 +14,7 @@ from __future__ import annotations
 import ctypes
 import json
 import os
+import selectors
 import shlex
 import shutil
 import signal
@@ -24,7 +25,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bench.node import BenchNode, merge_counts
+import numpy as np
+
+from bench.metrics import pointing_metrics
+from bench.node import BenchNode, frame_table, merge_counts
 from bench.plots import plot_run
 from bench.scenario import Scenario
 from dbc import load_database
@@ -36,6 +40,7 @@ DEFAULT_FSW_CMD = (
     "--config {config} --stats {stats}"
 )
 FSW_TERM_TIMEOUT_S = 5.0
+EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH = 0, 3, 4
 PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
 
@@ -67,6 +72,14 @@ def _fsw_argv(template: str, opts: RunOptions, config: Path, stats: Path) -> lis
         raise RunError(f"--fsw-cmd {template!r}: bad placeholder ({exc})") from exc
 
 
+class Terminated(Exception):  # noqa: N818 - a request, not an error
+    """SIGTERM in the bench process: finish the run folder, then exit."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated(f"signal {signum}")
+
+
 def _die_with_parent() -> None:
     """In the child: ask Linux for SIGTERM when the bench process dies (even by SIGKILL).
 
@@ -94,12 +107,57 @@ def run_scenario(
     progress: Callable[[float, float], None] | None = None,
     ready: Callable[[Path], None] | None = None,
 ) -> dict[str, Any]:
-    """Run ``sc``; returns the summary (also written to ``opts.out/summary.json``)."""
+    """Run ``sc``; returns the summary (also written to ``opts.out/summary.json``).
+
+    The bench runs in a forked child process and this process supervises it, so that the
+    run folder is completed (from the files written so far) even if the bench is killed.
+    """
     out = opts.out
     out.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(sc.path, out / "scenario.toml")
     config = out / "fsw_config.json"
     config.write_text(json.dumps(sc.fsw_config(), indent=2) + "\n", encoding="utf-8")
+    if not hasattr(os, "fork"):  # pragma: no cover - no supervisor where fork is missing
+        return _run_bench(sc, opts, progress, ready, config)
+    pid = os.fork()
+    if pid == 0:  # the bench process
+        code = EXIT_CHILD_OK
+        try:
+            _die_with_parent()
+            signal.signal(signal.SIGTERM, _terminate)
+            (out / "bench.pid").write_text(f"{os.getpid()}\n", encoding="utf-8")
+            _run_bench(sc, opts, progress, ready, config)
+        except RunError:
+            code = EXIT_CHILD_RUN_ERROR
+        except BaseException:
+            code = EXIT_CHILD_CRASH
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(code)
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # the bench handles Ctrl-C itself
+    try:
+        _, status = os.waitpid(pid, 0)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if os.WIFSIGNALED(status):
+        summary = partial_summary(sc, opts, f"bench process killed by signal {os.WTERMSIG(status)}")
+        raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    if os.WEXITSTATUS(status) != EXIT_CHILD_OK:
+        raise RunError(f"run failed ({summary.get('error')}); run folder: {out}")
+    return summary
+
+
+def _run_bench(
+    sc: Scenario,
+    opts: RunOptions,
+    progress: Callable[[float, float], None] | None,
+    ready: Callable[[Path], None] | None,
+    config: Path,
+) -> dict[str, Any]:
+    """The bench process: run, then write summary.json and plots (whatever happened)."""
+    out = opts.out
     stats = out / "fsw_stats.json"
     db = load_database()
     bus = open_bus(opts.bus)
@@ -120,6 +178,7 @@ def run_scenario(
                 preexec_fn=_die_with_parent,
             )
             log.close()
+            (out / "fsw.pid").write_text(f"{proc.pid}\n", encoding="utf-8")
             node.fsw_alive = lambda: proc is not None and proc.poll() is None
         if opts.mode == "lockstep":
             node.run_lockstep(opts.duration_s)
@@ -171,3 +230,97 @@ def _fsw_report(stats: Path, rc: int | None, out: Path) -> dict[str, Any]:
         )
         rep["log_tail"] = tail
     return rep
+
+
+def _wait_for_fsw_exit(out: Path) -> None:
+    """After the bench died: give its flight-software child time to write its statistics."""
+    try:
+        pid = int((out / "fsw.pid").read_text(encoding="utf-8"))
+        fd = os.pidfd_open(pid)
+    except (OSError, ValueError, AttributeError):
+        return
+    try:
+        sel = selectors.DefaultSelector()
+        sel.register(fd, selectors.EVENT_READ)  # readable when the process has exited
+        sel.select(timeout=FSW_TERM_TIMEOUT_S)
+        sel.close()
+    finally:
+        os.close(fd)
+
+
+def partial_summary(sc: Scenario, opts: RunOptions, why: str) -> dict[str, Any]:
+    """summary.json rebuilt from the files a killed bench left behind (flushed as it ran)."""
+    out = opts.out
+    _wait_for_fsw_exit(out)
+    db = load_database()
+    tel = _read_numeric_csv(out / "telemetry.csv")
+    t = tel.get("t_s", np.zeros(0))
+    pm = pointing_metrics(t, tel.get("att_err_deg", np.zeros(0)),
+                          tel.get("rate_err_deg_s", np.zeros(0)),
+                          sc.expectations.settling_band_deg, sc.expectations.steady_state_window_s,
+                          sc.manoeuvre_start_s)
+    frames = frame_table(db)
+    fr = _read_numeric_csv(out / "frames.csv")
+    name_of = {m.frame_id: m.name for m in db.messages}
+    sent: dict[str, int] = {}
+    received: dict[str, dict[str, Any]] = {}
+    for can_id, tx in zip(fr.get("id", []), fr.get("tx", []), strict=True):
+        name = name_of.get(int(can_id))
+        if name is None:
+            continue
+        if tx:
+            sent[name] = sent.get(name, 0) + 1
+        else:
+            r = received.setdefault(name, {"received": 0, "gaps": 0, "rejected": {}})
+            r["received"] += 1
+    other: dict[str, dict[str, int]] = {}
+    merge_counts(frames, other, "BENCH", sent, received)
+    faults = []
+    events = out / "events.jsonl"
+    if events.exists():
+        for line in events.read_text(encoding="utf-8").splitlines():
+            try:
+                ev = json.loads(line)
+            except json.JSONDecodeError:
+                continue  # a line cut by the kill
+            if ev.get("event") == "fault_injected":
+                faults.append(ev)
+    summary: dict[str, Any] = {
+        "scenario": sc.name, "scenario_file": sc.path, "mode": opts.mode, "seed": opts.seed,
+        "bus": opts.bus, "sim_time_s": float(t[-1]) if len(t) else 0.0, "wall_time_s": None,
+        "realtime_factor": None, "converged": pm.converged, "settling_time_s": pm.settling_time_s,
+        "steady_state_attitude_error_deg": pm.steady_state_attitude_error_deg,
+        "steady_state_rate_error_deg_s": pm.steady_state_rate_error_deg_s,
+        "propellant_kg": float(tel["propellant_kg"][-1]) if len(t) else 0.0,
+        "valve_openings": None, "frames": frames, "rejected_other": other,
+        "latency_us": {"sensor_to_command": {"p50": None, "p99": None, "max": None, "n": 0}},
+        "deadline_misses": None, "faults": faults, "expectations": [], "passed": False,
+        "error": why, "partial": True,
+    }
+    summary["fsw"] = _fsw_report(out / "fsw_stats.json", None, out)
+    merge_counts(frames, other, "FSW", summary["fsw"].get("sent", {}),
+                 summary["fsw"].get("received", {}))
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    plot_run(out, sc.expectations.settling_band_deg)
+    return summary
+
+
+def _read_numeric_csv(path: Path) -> dict[str, np.ndarray]:
+    """Columns of a numeric CSV written as the run went; a line cut short at the end is skipped."""
+    if not path.exists():
+        return {}
+    lines = path.read_text(encoding="utf-8").splitlines()
+    if not lines:
+        return {}
+    head = lines[0].split(",")
+    rows = []
+    for line in lines[1:]:
+        parts = line.split(",")
+        if len(parts) != len(head):
+            continue
+        try:
+            rows.append([float(x) for x in parts])
+        except ValueError:
+            continue
+    data = np.array(rows, dtype=float).reshape(-1, len(head))
+    return {h: data[:, i] for i, h in enumerate(head)}
