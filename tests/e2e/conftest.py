@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import selectors
 import subprocess
 import sys
 import uuid
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -58,3 +61,65 @@ def runtime_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def unique_bus() -> str:
     """A portable-bus spec no other test uses."""
     return f"hilbus:t{uuid.uuid4().hex[:10]}"
+
+
+PROGRESS_DEADLINE_S = 120.0
+
+
+@contextlib.contextmanager
+def running(
+    args: list[str], out: Path, runtime_dir: Path, min_percent: float = 0.0
+) -> Iterator[subprocess.Popen[str]]:
+    """``thruster-hil ARGS --out OUT`` in the background, entered once its progress passes
+    ``min_percent``; on exit it is waited for (and killed if a test failed meanwhile)."""
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
+    p = subprocess.Popen(
+        [sys.executable, "-m", "bench.cli", *args, "--out", str(out)],
+        cwd=REPO,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert p.stderr is not None
+        sel = selectors.DefaultSelector()
+        sel.register(p.stderr, selectors.EVENT_READ)
+        while True:  # real progress lines, read as they come
+            assert sel.select(timeout=PROGRESS_DEADLINE_S), "no progress from the run"
+            line = p.stderr.readline()
+            assert line, "the run ended before it made progress"
+            if line.startswith("progress") and float(line.split()[1]) > min_percent:
+                break
+        sel.close()
+        yield p
+        p.communicate(timeout=RUN_TIMEOUT_S)
+    finally:
+        if p.poll() is None:
+            p.kill()
+        p.communicate()
+
+
+def flood(bus: str, runtime_dir: Path, frames: int, rate_hz: float) -> dict[str, Any]:
+    """Run the hostile-input generator to completion; what it sent, per receiver and cause."""
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "bench.flood",
+            "--bus",
+            bus,
+            "--frames",
+            str(frames),
+            "--rate-hz",
+            str(rate_hz),
+        ],
+        cwd=REPO,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=RUN_TIMEOUT_S,
+        check=True,
+    )
+    return dict(json.loads(done.stdout))

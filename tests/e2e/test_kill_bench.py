@@ -6,14 +6,12 @@ import json
 import os
 import selectors
 import signal
-import subprocess
-import sys
 from pathlib import Path
 
 import can
 import pytest
 
-from tests.e2e.conftest import QUICKSTART, REPO, unique_bus
+from tests.e2e.conftest import QUICKSTART, running, unique_bus
 
 pytestmark = pytest.mark.slow
 
@@ -39,38 +37,11 @@ def test_sigkill_of_bench_leaves_readable_files_and_no_orphan(
 ) -> None:
     """After kill -9 of the bench: partial summary, trace and telemetry parse, FSW exits."""
     out = tmp_path / "run"
-    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
-    p = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "bench.cli",
-            "run",
-            str(QUICKSTART),
-            "--bus",
-            unique_bus(),
-            "--out",
-            str(out),
-        ],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert p.stderr is not None
-    sel = selectors.DefaultSelector()
-    sel.register(p.stderr, selectors.EVENT_READ)
-    while True:  # wait for real progress lines, then kill
-        assert sel.select(timeout=DEADLINE_S), "no progress from the run"
-        line = p.stderr.readline()
-        assert line, "run ended before it could be killed"
-        if line.startswith("progress") and float(line.split()[1]) >= KILL_AFTER_PERCENT:
-            break
-    bench_pid = int((out / "bench.pid").read_text())
-    os.kill(bench_pid, signal.SIGKILL)  # the bench process, not its supervisor
-    p.wait(DEADLINE_S)
-    p.stderr.close()
+    with running(
+        ["run", str(QUICKSTART), "--bus", unique_bus()], out, runtime_dir, KILL_AFTER_PERCENT
+    ) as p:
+        os.kill(int((out / "bench.pid").read_text()), signal.SIGKILL)  # the bench, not its
+        p.wait(DEADLINE_S)  # supervisor: that one completes the folder and exits
     s = json.loads((out / "summary.json").read_text())
     assert s["partial"] and "signal 9" in s["error"]
     assert s["sim_time_s"] > 0 and s["frames"]["SYNC"]["sent"] > 0

@@ -3,10 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
-import selectors
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -14,7 +10,7 @@ import pytest
 from bench.inject import FaultCommand, cansend_string, inject
 from dbc import load_database
 from dbc.codec import FrameChecker
-from tests.e2e.conftest import QUICKSTART, REPO, unique_bus
+from tests.e2e.conftest import QUICKSTART, running, unique_bus
 
 pytestmark = pytest.mark.slow
 
@@ -27,48 +23,11 @@ def test_inject_reaches_running_bench(
     tmp_path: Path, runtime_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """inject(stuck_open) during a realtime run: acknowledged, applied, in events and summary."""
-    bus = unique_bus()
-    out = tmp_path / "run"
-    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
+    bus, out = unique_bus(), tmp_path / "run"
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime_dir))
-    p = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "bench.cli",
-            "run",
-            str(QUICKSTART),
-            "--bus",
-            bus,
-            "--mode",
-            "realtime",
-            "--duration",
-            RUN_S,
-            "--out",
-            str(out),
-        ],
-        cwd=REPO,
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert p.stderr is not None
-    try:
-        sel = selectors.DefaultSelector()
-        sel.register(p.stderr, selectors.EVENT_READ)
-        while True:  # the run is going once progress lines appear
-            assert sel.select(timeout=DEADLINE_S), "no progress from the run"
-            line = p.stderr.readline()
-            assert line, "run ended early"
-            if line.startswith("progress") and float(line.split()[1]) > 0.0:
-                break
+    args = ["run", str(QUICKSTART), "--bus", bus, "--mode", "realtime", "--duration", RUN_S]
+    with running(args, out, runtime_dir):
         counter = inject(bus, FaultCommand("stuck_open", STUCK))
-        p.communicate(timeout=DEADLINE_S)
-    finally:
-        if p.poll() is None:
-            p.kill()
-            p.communicate()
     s = json.loads((out / "summary.json").read_text())
     live = [f for f in s["faults"] if f.get("source") == "FAULT_CMD"]
     assert live and live[0]["kind"] == "stuck_open" and live[0]["thruster"] == STUCK
