@@ -22,6 +22,7 @@ from dbc.bus import BusSpec, default_bus_spec
 from dbc.errors import BusError, ConfigError, RunError
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 BAR_WIDTH = 30
 
 
@@ -42,24 +43,34 @@ def _progress_printer() -> Any:
     return show
 
 
+def _fmt(x: Any, spec: str = ".4f", none: str = "n/a") -> str:
+    return none if x is None else format(x, spec)
+
+
 def _print_summary(s: dict[str, Any], out: Path) -> None:
     lat = s["latency_us"]["sensor_to_command"]
+    dm = s.get("deadline_misses") or {}
+    settling = s["settling_time_s"]
     lines = [
         f"scenario {s['scenario']} | mode {s['mode']} | bus {s['bus']} | seed {s['seed']}",
-        f"sim {s['sim_time_s']:.1f} s in {s['wall_time_s']:.2f} s wall "
-        f"(real-time factor {s['realtime_factor']})",
-        f"converged {s['converged']} | settling {s['settling_time_s']} s | "
-        f"steady-state error {s['steady_state_attitude_error_deg']:.4f} deg, "
-        f"{s['steady_state_rate_error_deg_s']:.4f} deg/s",
-        f"propellant {s['propellant_kg'] * 1000:.1f} g | "
-        f"valve openings {s['valve_openings']['total']}",
-        f"latency sensor->command p50 {lat['p50']} us, p99 {lat['p99']} us, max {lat['max']} us "
-        f"(n={lat['n']}) | deadline misses {s['deadline_misses']}",
+        f"sim {s['sim_time_s']:.1f} s in {_fmt(s['wall_time_s'], '.2f')} s wall "
+        f"(real-time factor {_fmt(s['realtime_factor'], '.1f')})",
+        f"converged {s['converged']} | settling "
+        f"{'not settled' if settling is None else f'{settling:.2f} s'} | steady-state error "
+        f"{_fmt(s['steady_state_attitude_error_deg'])} deg, "
+        f"{_fmt(s['steady_state_rate_error_deg_s'])} deg/s",
+        f"propellant {s['propellant_kg'] * 1000:.1f} g | valve openings "
+        f"{(s.get('valve_openings') or {}).get('total', 'n/a')}",
+        f"latency sensor->command p50 {_fmt(lat['p50'], '.0f')} us, p99 {_fmt(lat['p99'], '.0f')}"
+        f" us, max {_fmt(lat['max'], '.0f')} us (n={lat['n']}) | stalls {dm.get('stalls', 0)}, "
+        f"flight-software overruns {dm.get('fsw_overruns', 0)}, "
+        f"bench late {dm.get('bench_late', 0)}",
     ]
     for e in s["expectations"]:
-        lines.append(
-            f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {e['value']} (max {e['max']})"
-        )
+        lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {_fmt(e['value'])} "
+                     f"(max {e['max']})")
+    for w in s.get("warnings", []):
+        lines.append(f"  WARNING {w}")
     if "error" in s:
         lines.append(f"  ERROR {s['error']}")
     lines.append(f"run folder: {out}")
@@ -89,7 +100,8 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
     def ready(config: Path) -> None:
         print(
             f"bench ready on {bus}, mode {opts.mode}: waiting up to "
-            f"{sc.bus.startup_timeout_s} s for flight software (FSW_STATUS heartbeat); "
+            f"{sc.bus.startup_timeout_s} s for flight software (FSW_STATUS heartbeat), e.g. "
+            f"`python -m flight_sw --bus {bus} --mode {opts.mode} --config {config}`; "
             f"its configuration: {config}",
             file=sys.stderr,
             flush=True,
@@ -108,12 +120,12 @@ def _cmd_report(args: argparse.Namespace) -> int:
     run_dir = Path(args.run_dir)
     path = run_dir / "summary.json"
     if not path.exists():
-        raise RunError(f"{path}: no summary.json (not a run folder?)")
+        raise ConfigError(str(run_dir), "summary.json", None, "a run folder (no summary.json)")
     s = json.loads(path.read_text(encoding="utf-8"))
     for p in plot_run(run_dir, s.get("settling_band_deg")):
         print(f"wrote {p}")
     _print_summary(s, run_dir)
-    return EXIT_OK
+    return EXIT_OK if s.get("passed") else EXIT_FAILED
 
 
 def _cmd_timing(args: argparse.Namespace) -> int:
@@ -325,6 +337,10 @@ def main(argv: list[str] | None = None) -> int:
     except RunError as exc:
         print(f"thruster-hil: run error: {exc}", file=sys.stderr)
         return EXIT_RUN_ERROR
+    except KeyboardInterrupt:
+        print("\nthruster-hil: interrupted (the run folder was completed with what ran)",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

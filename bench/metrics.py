@@ -3,7 +3,8 @@
 Pure functions over arrays. Inputs: sample times [s], attitude error angle [deg] between
 true attitude and the manoeuvre's target, rate error [deg/s]. Settling time is the first
 time after which the error stays inside the band until the end; converged means settled
-and the final error inside the band. Steady-state errors are maxima over the last window.
+and the final error inside the band. Steady-state errors are maxima over the last window,
+or over the time since settling if that is shorter (a run shorter than the window).
 """
 
 from __future__ import annotations
@@ -46,7 +47,11 @@ def pointing_metrics(
         settling = None
     else:
         settling = float(t_s[outside[-1] + 1] - t_start_s)
-    last = t_s >= t_s[-1] - window_s
+    # the steady state starts at settling: the last window, or less if settling came later
+    start = t_s[-1] - window_s
+    if settling is not None:
+        start = max(start, t_start_s + settling)
+    last = t_s >= start
     return PointingMetrics(
         converged=settling is not None and final <= band_deg,
         settling_time_s=settling,

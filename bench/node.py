@@ -18,7 +18,6 @@ periods closes every valve and records the event.
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from collections.abc import Callable
@@ -34,7 +33,7 @@ from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_tim
 from bench.faults import BUS_KINDS, NO_FATE, FaultSpec, fault_from_command, frame_fate
 from bench.metrics import expectation, latency_summary, pointing_metrics
 from bench.plant import STEP_NS, Plant
-from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder
+from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
 from bench.scenario import Scenario
 from dbc.codec import Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.errors import RunError
@@ -158,7 +157,8 @@ class BenchNode:
         self.mode, self.seed, self.bus_spec = mode, seed, bus_spec
         self.progress = progress
         self.encoder = Encoder(db)
-        self.checker = FrameChecker(db, accept=FSW_FRAMES)
+        self.checker = FrameChecker(db, accept=FSW_FRAMES, own=frozenset(
+            m.name for m in db.messages if m.senders and m.senders[0] == BENCH_NODE))
         self.period_ns = cycle_time_ns(db, "THR_CMD_0")
         self.sensor_period_ns = {n: cycle_time_ns(db, n) for n in SENSOR_ORDER}
         self.sensors_sent = tuple(
@@ -859,7 +859,5 @@ class BenchNode:
         self.pulses.close()
         self.chains.close()
         summary = self.summary(sim_time_s)
-        (self.run_dir / "summary.json").write_text(
-            json.dumps(summary, indent=2) + "\n", encoding="utf-8"
-        )
+        write_summary(self.run_dir / "summary.json", summary)
         return summary

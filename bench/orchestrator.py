@@ -30,10 +30,12 @@ import numpy as np
 from bench.metrics import pointing_metrics
 from bench.node import BenchNode, frame_table, merge_counts
 from bench.plots import plot_run
+from bench.recorder import write_summary
 from bench.scenario import Scenario
 from dbc import load_database
 from dbc.bus import open_bus
-from dbc.errors import RunError
+from dbc.codec import cycle_time_ns
+from dbc.errors import ConfigError, RunError
 
 DEFAULT_FSW_CMD = (
     f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
@@ -57,9 +59,11 @@ class RunOptions:
 
     def __post_init__(self) -> None:
         if self.mode not in ("lockstep", "realtime"):
-            raise RunError(f"--mode {self.mode!r}: expected lockstep or realtime")
-        if not self.duration_s > 0:
-            raise RunError(f"--duration {self.duration_s!r}: expected a positive number of seconds")
+            raise ConfigError("command line", "--mode", self.mode, "lockstep or realtime")
+        period_s = cycle_time_ns(load_database(), "THR_CMD_0") / 1e9
+        if not self.duration_s >= period_s:  # also rejects NaN
+            raise ConfigError("command line", "--duration", self.duration_s,
+                              f"at least one control period ({period_s} s)")
 
 
 def _fsw_argv(template: str, opts: RunOptions, config: Path, stats: Path) -> list[str]:
@@ -69,7 +73,9 @@ def _fsw_argv(template: str, opts: RunOptions, config: Path, stats: Path) -> lis
             for a in shlex.split(template)
         ]
     except (KeyError, IndexError, ValueError) as exc:
-        raise RunError(f"--fsw-cmd {template!r}: bad placeholder ({exc})") from exc
+        raise ConfigError("command line", "--fsw-cmd", template,
+                          f"placeholders among {{bus}} {{mode}} {{config}} {{stats}} {{run_dir}} "
+                          f"({exc})") from exc
 
 
 class Terminated(Exception):  # noqa: N818 - a request, not an error
@@ -200,16 +206,41 @@ def _run_bench(
         summary["deadline_misses"]["total"] = sum(
             v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns")
         )
+    summary["warnings"] = bus_warnings(summary["frames"])
+    if any("another node" in w for w in summary["warnings"]):
+        summary["passed"] = False
     if error is not None:
         summary["error"] = f"{type(error).__name__}: {error}"
+        if "first frame" in str(error):
+            summary["fsw"]["log_tail"] = _log_tail(out / "fsw.log")
         summary["passed"] = False
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    write_summary(out / "summary.json", summary)
     plot_run(out, sc.expectations.settling_band_deg)
     if error is not None and not isinstance(error, Exception):
         raise error  # KeyboardInterrupt and friends, after the folder is complete
     if error is not None:
-        raise RunError(f"run failed ({summary['error']}); run folder: {out}") from error
+        tail = "".join(f"\n  fsw.log: {x}" for x in summary["fsw"].get("log_tail", []))
+        raise RunError(f"run failed ({summary['error']}); run folder: {out}{tail}") from error
     return summary
+
+
+def bus_warnings(frames: dict[str, dict[str, Any]]) -> list[str]:
+    """Signs that something else shares the bus: own messages from another node, stale frames."""
+    out = []
+    for name, f in frames.items():
+        rej = f.get("rejected") or {}
+        if rej.get("unexpected"):
+            out.append(f"another node sends {name} on this bus ({rej['unexpected']} frames): "
+                       "a second bench or flight software? Use a bus of your own (--bus).")
+        if rej.get("stale"):
+            out.append(f"{rej['stale']} stale {name} frames (for another cycle)")
+    return out
+
+
+def _log_tail(log: Path, lines: int = 5) -> list[str]:
+    if not log.exists():
+        return []
+    return log.read_text(encoding="utf-8", errors="replace").splitlines()[-lines:]
 
 
 def _fsw_report(stats: Path, rc: int | None, out: Path) -> dict[str, Any]:
@@ -222,13 +253,7 @@ def _fsw_report(stats: Path, rc: int | None, out: Path) -> dict[str, Any]:
     else:
         rep["stats_error"] = "flight software wrote no statistics"
     if rc not in (0, None):
-        log = out / "fsw.log"
-        tail = (
-            log.read_text(encoding="utf-8", errors="replace").splitlines()[-5:]
-            if log.exists()
-            else []
-        )
-        rep["log_tail"] = tail
+        rep["log_tail"] = _log_tail(out / "fsw.log")
     return rep
 
 
@@ -300,7 +325,7 @@ def partial_summary(sc: Scenario, opts: RunOptions, why: str) -> dict[str, Any]:
     summary["fsw"] = _fsw_report(out / "fsw_stats.json", None, out)
     merge_counts(frames, other, "FSW", summary["fsw"].get("sent", {}),
                  summary["fsw"].get("received", {}))
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+    write_summary(out / "summary.json", summary)
     plot_run(out, sc.expectations.settling_band_deg)
     return summary
 

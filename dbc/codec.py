@@ -40,7 +40,7 @@ class Reject(str, Enum):
     COUNTER = "counter"  # repeated or invalid (15) alive counter
     RANGE = "range"
     STALE = "stale"
-    UNEXPECTED = "unexpected"  # known frame from the wrong sender for this receiver
+    UNEXPECTED = "unexpected"  # one of this node's own messages, sent by another node
 
 
 def data_id(message: Message) -> int:
@@ -174,12 +174,18 @@ class FrameStats:
 class FrameChecker:
     """Checks and decodes received frames, counting rejects by cause per message."""
 
-    def __init__(self, db: Database, accept: frozenset[str] | None = None) -> None:
-        """``accept``: names this receiver consumes; other known frames are ignored, not counted."""
+    def __init__(self, db: Database, accept: frozenset[str] | None = None,
+                 own: frozenset[str] = frozenset()) -> None:
+        """``accept``: names this receiver consumes; other known frames are ignored, not counted.
+
+        ``own``: names this node sends itself. Receiving one means another node on the bus
+        sends them too (a second bench, a second flight software): counted as UNEXPECTED.
+        """
         self._by_id: dict[int, tuple[Message, int, list[tuple[str, float, float]]]] = {}
         for m in db.messages:
             self._by_id[m.frame_id] = (m, data_id(m), _range_checks(m))
         self._accept = accept
+        self._own = own
         self._last_counter: dict[int, int] = {}
         self.stats: dict[str, FrameStats] = defaultdict(FrameStats)
 
@@ -199,6 +205,8 @@ class FrameChecker:
         message, did, limits = entry
         name = message.name
         if self._accept is not None and name not in self._accept:
+            if name in self._own:
+                self._count_reject(name, Reject.UNEXPECTED)
             return None
         if msg.is_remote_frame:
             self._count_reject(name, Reject.REMOTE_FRAME)

@@ -9,12 +9,14 @@ Nothing is ever evaluated: values are data only.
 
 from __future__ import annotations
 
+import difflib
 import math
 from typing import Any
 
 from dbc.errors import ConfigError
 
 _MISSING = object()
+NEAR_MISS_CUTOFF = 0.75  # difflib similarity above which a present key is suggested
 
 
 class Table:
@@ -44,7 +46,10 @@ class Table:
         self._used.add(key)
         if key not in self._data:
             if default is _MISSING:
-                raise self.error(key, None, "a value (key is required)")
+                near = difflib.get_close_matches(key, [str(k) for k in self._data], n=1,
+                                                 cutoff=NEAR_MISS_CUTOFF)
+                hint = f"; found {near[0]!r}: misspelt?" if near else ""
+                raise self.error(key, None, f"a value (key is required{hint})")
             return default
         return self._data[key]
 

@@ -50,9 +50,10 @@ Faults (``set_fault`` / ``clear_fault``; DESIGN.md §7)
     - ``"stuck_closed"`` (no parameter): the valve is driven closed from the fault time
       on and never opens (any thrust in progress decays with the tail); the coil still
       energises and reports current. Setting it clears ``stuck_open``.
-    - ``"stuck_open"`` (no parameter): once the valve is (or next becomes) driven open
-      it never closes, whatever is commanded: full thrust after the opening transient;
-      ``status`` reports it open with the coil off. Setting it clears ``stuck_closed``.
+    - ``"stuck_open"`` (no parameter): the valve fails open: from the fault time (after
+      the opening delay, unless it is already open) it never closes, whatever is
+      commanded: full thrust after the opening transient; ``status`` reports it open with
+      the coil off. Setting it clears ``stuck_closed``.
     - ``"degraded"``, ``factor`` [-] in [0, 1]: from the fault time the thrust is
       exactly ``factor`` × the nominal thrust (rise and tail included, so a pulse gives
       ``factor`` × ``pulse_impulse_Ns``); models a partly blocked injector or a low feed
@@ -598,7 +599,12 @@ class Valve:
             drive_now, edges = False, []
         elif self._stuck == FAULT_STUCK_OPEN:
             drive_now = drive_now or driven_before
-            edges = [] if drive_now else [e for e in edges if e[1]][:1]
+            if drive_now:
+                edges = []
+            else:  # fails open: opens one opening delay after the fault, or earlier if driven
+                fails_open = t_ns + prm.open_delay_ns + self._extra_delay_ns
+                commanded = [e[0] for e in edges if e[1]][:1]
+                edges = [(min([fails_open, *commanded]), True)]
 
         # Keep the segments needed for t in [min(previous event, t_ns − history), t_ns),
         # then plan from t_ns.

@@ -606,3 +606,15 @@ def test_star_tracker_frozen_and_outage() -> None:
     with pytest.raises(ConfigError) as exc:
         st.set_fault("bias_jump", misalignment_arcsec=(1.0, math.inf, 0.0))
     assert exc.value.key == "misalignment_arcsec"
+
+
+def test_stuck_open_on_an_idle_valve_fails_open_after_the_opening_delay() -> None:
+    """A closed, idle valve that sticks open starts thrusting one opening delay later."""
+    p = _params()
+    v = Valve(p)
+    t_fault = 1_000_000_000
+    v.set_fault("stuck_open", t_fault)
+    t_open = t_fault + round(p.open_delay_s * 1e9)
+    assert v.thrust_N(t_open) == 0.0
+    assert v.thrust_N(t_open + 20 * round(p.rise_tau_s * 1e9)) == pytest.approx(p.max_thrust_N)
+    assert v.status(t_open + 20 * round(p.rise_tau_s * 1e9))[1]  # reported open
