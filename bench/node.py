@@ -40,6 +40,7 @@ from dbc.errors import RunError
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 
 WATCHDOG_PERIODS = 3
+MODE_BOOT = 0  # FSW_STATUS.Mode
 FAULT_CMD_NONE = 15  # BENCH_STATUS.FaultCmdCounter before any FAULT_CMD
 FAULT_RNG_STREAM = 0xFA  # spawn key of the fault-injection random stream
 BENCH_NODE = "BENCH"
@@ -200,6 +201,7 @@ class BenchNode:
         self.delayed: list[tuple[int, can.Message, str]] = []
         self.fault_cmd_counter = FAULT_CMD_NONE
         self.fdir: dict[str, Any] = {}
+        self.fsw_restarts = 0
         self.fault_counts: dict[str, int] = {
             k: 0 for k in ("dropped", "delayed", "corrupted", "duplicated", "babbled")}
         self.fault_rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
@@ -512,6 +514,10 @@ class BenchNode:
         elif d_name == "FSW_FDIR":
             self._on_fdir(s)
         elif d_name == "FSW_STATUS":
+            if int(s["Mode"]) == MODE_BOOT and self.fsw_status.get("Mode", MODE_BOOT) != MODE_BOOT:
+                # the flight software booted again: its counters restart, its state is new
+                self.fsw_restarts += 1
+                self.trace.event(self.plant.t_ns, "fsw_restart", count=self.fsw_restarts)
             self.fsw_status = s
         elif d_name == "FSW_ATT_EST":
             self.fsw_q_est = unpack_quaternion(s)
@@ -845,6 +851,7 @@ class BenchNode:
                 "fsw_overruns": int(self.fsw_status.get("Overruns", 0)),
             },
             "valve_watchdog_trips": self.watchdog_trips,
+            "fsw_restarts": self.fsw_restarts,
             "faults": self.faults_log,
             "fault_effects": dict(self.fault_counts),
             "fdir": self.fdir,

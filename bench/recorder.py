@@ -32,7 +32,7 @@ NS_PER_S = 1e9
 NAN = float("nan")
 # events also written into trace.asc (python-can's ASC reader skips such lines)
 TRACE_EVENTS = frozenset({"fault_injected", "fault_cleared", "valve_watchdog",
-                          "valve_watchdog_cleared", "fsw_silent", "fsw_back"})
+                          "valve_watchdog_cleared", "fsw_silent", "fsw_back", "fsw_restart"})
 COUNTER_MASK = 0x0F
 FRAME_COLUMNS = ["t_ready_s", "t_start_s", "t_rx_s", "id", "dlc", "bits", "tx", "counter"]
 CHAIN_COLUMNS = ["cycle", "imu_counter", "t_imu_tx_s", "t_cmd_rx_s", "t_valve_open_s"]

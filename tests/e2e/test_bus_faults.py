@@ -17,6 +17,7 @@ PERIOD_S = 0.02
 ERR_FROM_S, ERR_TO_S = 1.0, 2.0
 BUS_OFF_S = 2.5
 BUS_OFF_FOR_S = 0.005
+DELAY_FROM_S, DELAY_FOR_S, DELAY_S = 3.0, 0.5, 0.0005
 DURATION_S = "4"
 TOL_US = 0.5  # rounding of modelled times to the microsecond in frames.csv/chains.csv
 THR_CMD_BITS_MAX = 135  # 8-byte frame, worst-case stuffing
@@ -47,6 +48,8 @@ def test_link_errors_and_bus_off_delay_commands_as_modelled(
         'kind = "link_error"\nmessage = "THR_CMD_1"\nprobability = 1.0\n'
         f'\n[[faults]]\nt_s = {BUS_OFF_S}\nduration_s = {BUS_OFF_FOR_S}\nkind = "bus_off"\n'
         'node = "FSW"\n'
+        f'\n[[faults]]\nt_s = {DELAY_FROM_S}\nduration_s = {DELAY_FOR_S}\nkind = "delay"\n'
+        f'message = "THR_CMD_1"\ndelay_s = {DELAY_S}\n'
     )
     ref = run_cli(
         ["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", DURATION_S],
@@ -74,11 +77,16 @@ def test_link_errors_and_bus_off_delay_commands_as_modelled(
     off_end = BUS_OFF_S + BUS_OFF_FOR_S
     assert off_end < t_rx <= off_end + 2 * THR_CMD_BITS_MAX / BITRATE_BPS + TOL_US / 1e6
     assert _cmd_rx_s(ref.out)[k_off] < BUS_OFF_S + BUS_OFF_FOR_S / 2  # unaffected reference
+    delay_cycles = range(
+        round(DELAY_FROM_S / PERIOD_S), round((DELAY_FROM_S + DELAY_FOR_S) / PERIOD_S)
+    )
+    for k in delay_cycles:  # the delayed frame reaches the valves exactly delay_s later
+        assert lat[k] - base[k] == pytest.approx(DELAY_S * 1e6, abs=STUFFING_TOL_US), k
     # elsewhere only stuffing differs (the trajectory, hence the payloads, diverge slightly)
-    for k in set(base) - set(err_cycles) - {k_off}:
+    for k in set(base) - set(err_cycles) - set(delay_cycles) - {k_off}:
         assert lat[k] == pytest.approx(base[k], abs=STUFFING_TOL_US), k
     faults = run.summary["faults"]
-    assert [f["kind"] for f in faults] == ["link_error", "bus_off"]
+    assert [f["kind"] for f in faults] == ["link_error", "bus_off", "delay"]
 
 
 def _fault(kind: str, target: str, **params: object) -> str:

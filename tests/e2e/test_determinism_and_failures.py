@@ -111,3 +111,29 @@ def test_realtime_run_measures_latency(tmp_path: Path, runtime_dir: Path) -> Non
     assert lat["n"] > 0 and lat["p50"] > 0
     assert {"bench_late", "fsw_overruns"} <= set(s["deadline_misses"])
     assert s["wall_time_s"] >= float(REALTIME_S)
+
+
+RESTART_AT_CYCLE = 50
+MAX_RESTART_STALLS = 3  # cycles lost while the new process boots
+
+
+def test_flight_software_restart_is_detected_and_the_run_continues(
+    tmp_path: Path, runtime_dir: Path
+) -> None:
+    """The flight software dies and boots again: the bench records the restart and resumes."""
+    fsw_args = "--bus {bus} --mode {mode} --config {config} --stats {stats}"
+    killed = f"{sys.executable} {REPO / 'tests' / 'e2e' / 'fsw_killed.py'} {RESTART_AT_CYCLE}"
+    cmd = f"sh -c '{killed} {fsw_args}; exec {sys.executable} -m flight_sw {fsw_args}'"
+    r = run_cli(
+        ["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", SHORT_S, "--fsw-cmd", cmd],
+        tmp_path / "run",
+        runtime_dir,
+    )
+    s = r.summary
+    events = [json.loads(x)["event"] for x in (r.out / "events.jsonl").read_text().splitlines()]
+    assert s["fsw_restarts"] == 1
+    assert "fsw_restart" in events
+    assert 1 <= s["deadline_misses"]["stalls"] <= MAX_RESTART_STALLS
+    # after the restart every cycle is answered again
+    cycles = round(float(SHORT_S) / CONTROL_PERIOD_S)
+    assert s["frames"]["THR_CMD_0"]["received"] >= cycles - MAX_RESTART_STALLS
