@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
             load_config(args.config),
             cycle_time_ns(db, "THR_CMD_0"),
             cycle_time_ns(db, "IMU_RATE"),
-            {"IMU_RATE": cycle_time_ns(db, "IMU_RATE"), "STR_QUAT": cycle_time_ns(db, "STR_QUAT")},
+            {n: cycle_time_ns(db, n) for n in ("IMU_RATE", "STR_QUAT", "NAV_POS")},
         )
         if args.check:
             print(f"{args.config}: configuration ok")

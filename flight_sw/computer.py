@@ -1,33 +1,62 @@
 """The flight computer's application: one control cycle from sensor data to valve on-times.
 
-In (decoded ICD signals, via the node): IMU_RATE (omega_meas_B, rad/s) each gyro sample,
-STR_QUAT (q_meas_BN) each star-tracker sample, THR_STATUS (valve telemetry, kept for FDIR).
-Out of :meth:`FlightComputer.cycle`: per thruster an on-time [s] for the coming control
-period, mode, FDIR flags and the allocator's saturation and residual, and the alive counter
-of the newest IMU_RATE sample used (so the bench can measure sensor-to-actuator latency).
+In (decoded ICD signals, via the node): IMU_RATE (omega_meas_B, rad/s) and IMU_ACCEL
+(specific force f_B, m/s²) each sample, STR_QUAT (q_meas_BN) each star-tracker sample,
+NAV_POS / NAV_VEL (r_N [m], v_N [m/s] in the navigation frame N) in 6-DoF runs, THR_STATUS
+(valve telemetry, the FDIR input). Out of :meth:`FlightComputer.cycle`: per thruster an
+on-time [s] for the coming control period, mode, FDIR flags, sensor flags and the thruster
+FDIR report (FSW_FDIR), the allocator's saturation and torque residual, and the alive
+counter of the newest IMU_RATE sample used (sensor-to-actuator latency).
 
-Chain (seed 003's architecture): estimator (gyro propagation + star-tracker correction) ->
-attitude controller (torque demand, body axes, N m) -> allocator (thrust per thruster, N,
-bounded to [0, Tmax]) -> one modulator per thruster (demanded fraction -> on-time).
-Safe mode: IMU_RATE silent for 3 of its periods latches SAFE: every valve closed.
+Chain (seed 003's architecture, extended to 6 DoF after seed 000): estimator (gyro
+propagation + star-tracker correction) -> attitude controller (torque demand, body axes,
+N m) and, when a translation controller is configured, translation controller (force
+demand, body axes, N, from the navigation solution rotated with the estimated attitude)
+-> allocator (thrust per thruster, N, bounded to [0, Tmax]; 3 torque rows, or 6 wrench
+rows in 6 DoF) -> one modulator per thruster (demanded fraction -> on-time).
+
+FDIR (docs/fdir.md):
+- Safe mode: IMU_RATE silent for 3 of its periods latches SAFE: every valve closed. A
+  frozen IMU (identical samples, :mod:`flight_sw.fdir.frozen_sensor`) is ignored, so it
+  ends the same way.
+- Star tracker silent for 3 periods, or frozen: attitude propagated on the gyro only,
+  SensorFlags bit 0 (degraded); it recovers when valid, changing samples return.
+- Navigation (6 DoF) older than ``nav_timeout_ns``: the force demand is zero (attitude-only
+  control, translation coasting), FdirFlags NAV_LOST.
+- Thrusters (:mod:`flight_sw.fdir.thruster_fdir`): on isolation the allocator is replaced
+  by one built with the availability mask (cached per mask); a masked thruster's on-time
+  is 0 and its modulator restarts; for a stuck-open thruster its known wrench
+  (its column × Tmax) is subtracted from the demand, so the others counter it.
+- Bench restart (:meth:`FlightComputer.restart`, called by the node): estimator,
+  modulators, FDIR, watchdog, safe latch and manoeuvre timeline start again from the
+  bench's new time; SensorFlags bit 3 and FdirFlags BENCH_RESTART stay set.
 Strategies are injected (one interface each); time is an argument; no I/O here.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from flight_sw.allocation.base import Allocator
-from flight_sw.control.base import AttitudeController
+from flight_sw.control.base import AttitudeController, TranslationController
 from flight_sw.estimation.base import AttitudeEstimator
+from flight_sw.fdir.base import ThrusterFailure
+from flight_sw.fdir.frozen_sensor import FrozenSensorMonitor
 from flight_sw.fdir.sensor_watchdog import SensorWatchdog
-from flight_sw.modes import FdirFlag, Mode
+from flight_sw.fdir.thruster_fdir import FdirReport, ThrusterFdir
+from flight_sw.modes import FdirFlag, Mode, SensorFlag
 from flight_sw.modulation.base import Modulator
 
 NS_PER_S = 1_000_000_000
+TORQUE_DIM = 3
+WRENCH_DIM = 6
+ZERO3 = (0.0, 0.0, 0.0)
+MAX_THR_STATUS = 16  # THR_STATUS carries thrusters 0..15
+DEFAULT_NAV_TIMEOUT_NS = 300_000_000  # 3 NAV_POS periods of 100 ms
 
 
 @dataclass(frozen=True)
@@ -41,19 +70,29 @@ class CycleResult:
     residual_Nm: float
     imu_counter: int
     torque_cmd_B_Nm: tuple[float, float, float]
+    force_cmd_B_N: tuple[float, float, float] = ZERO3
+    sensor_flags: int = 0
+    fdir: FdirReport | None = None
 
 
 @dataclass
 class Timeline:
-    """The manoeuvre: hold until ``t_start_ns``, then point at ``q_target_BN``."""
+    """The manoeuvre: hold until ``t_start_ns``, then point at ``q_target_BN``.
+
+    Times are relative to ``time_base_ns`` (the flight-software time of the bench's time 0:
+    0 in lockstep, where the flight software runs on the bench's time). ``r_target_N_m``:
+    the position to hold in 6 DoF (None: the first navigation fix).
+    """
 
     q_target_BN: np.ndarray
     t_start_ns: int
+    r_target_N_m: np.ndarray | None = None
+    time_base_ns: int = 0
 
 
 @dataclass
 class FlightComputer:
-    """Estimator, controller, allocator and modulators wired into one cycle."""
+    """Estimator, controllers, allocator, modulators and FDIR wired into one cycle."""
 
     estimator: AttitudeEstimator
     controller: AttitudeController
@@ -64,27 +103,163 @@ class FlightComputer:
     imu_period_ns: int
     timeline: Timeline
     watchdog: SensorWatchdog
+    translation: TranslationController | None = None
+    effectiveness: np.ndarray | None = None  # the allocator's rows (m×n), for feed-forward
+    thruster_fdir: ThrusterFdir | None = None
+    sensor_monitor: FrozenSensorMonitor = field(default_factory=lambda: FrozenSensorMonitor({}))
+    make_estimator: Callable[[], AttitudeEstimator] | None = None
+    make_modulator: Callable[[], Modulator] | None = None
+    allocators_by_mask: dict[tuple[bool, ...], Allocator] = field(default_factory=dict)
+    nav_timeout_ns: int = DEFAULT_NAV_TIMEOUT_NS
     mode: Mode = Mode.BOOT
     safe_latched: bool = False
     imu_counter: int = 0
-    _imu_t_ns: int | None = None
-    _q_hold_BN: np.ndarray | None = None
+    restarts: int = 0
     thr_status: dict[str, Any] = field(default_factory=dict)
+    _imu_t_ns: int | None = None
+    _acc_t_ns: int | None = None
+    _q_hold_BN: np.ndarray | None = None
+    _r_hold_N_m: np.ndarray | None = None
+    _nav_r: tuple[int, np.ndarray] | None = None
+    _nav_v: tuple[int, np.ndarray] | None = None
+    _allocator_full: Allocator | None = None
 
-    def on_imu_rate(self, t_ns: int, omega_meas_B: np.ndarray, counter: int, gap: int) -> None:
-        """One gyro sample; its time is rebuilt from the IMU period and counter gaps."""
+    def __post_init__(self) -> None:
+        self._allocator_full = self.allocator
+
+    # --- sensor input -------------------------------------------------------------------
+
+    def on_imu_rate(self, t_ns: int, omega_meas_B: np.ndarray, counter: int, gap: int) -> bool:
+        """One gyro sample; its time is rebuilt from the IMU period and counter gaps.
+
+        Returns False if the sample was ignored as frozen data (then it does not count as
+        seen for the IMU watchdog).
+        """
         if self._imu_t_ns is None:
             self._imu_t_ns = t_ns
         else:
             self._imu_t_ns += self.imu_period_ns * (1 + gap)
-        self.estimator.propagate(self._imu_t_ns, omega_meas_B)
+        omega = np.asarray(omega_meas_B, dtype=float)
+        if self.sensor_monitor.check("IMU_RATE", tuple(omega.tolist())):
+            return False
+        self.estimator.propagate(self._imu_t_ns, omega)
         self.imu_counter = counter
+        if self.thruster_fdir is not None:
+            self.thruster_fdir.on_gyro(self._imu_t_ns, omega)
+        return True
 
-    def on_star_tracker(self, t_ns: int, q_meas_BN: np.ndarray) -> None:
-        """One valid star-tracker attitude."""
+    def on_imu_accel(self, t_ns: int, f_meas_B: np.ndarray, counter: int, gap: int) -> bool:
+        """One accelerometer sample (the residual FDIR's linear channel)."""
+        if self._acc_t_ns is None:
+            self._acc_t_ns = t_ns
+        else:
+            self._acc_t_ns += self.imu_period_ns * (1 + gap)
+        if self.thruster_fdir is not None:
+            self.thruster_fdir.on_accel(self._acc_t_ns, np.asarray(f_meas_B, dtype=float))
+        return True
+
+    def on_star_tracker(
+        self, t_ns: int, q_meas_BN: np.ndarray, payload: tuple[float, ...] | None = None
+    ) -> bool:
+        """One valid star-tracker attitude; False if ignored as frozen data.
+
+        ``payload``: the frame's raw signal values for the frozen test (default: q).
+        """
+        q = np.asarray(q_meas_BN, dtype=float)
+        if self.sensor_monitor.check("STR_QUAT", payload if payload else tuple(q.tolist())):
+            return False
         self.estimator.update_star_tracker(
-            self._imu_t_ns if self._imu_t_ns is not None else t_ns, q_meas_BN
+            self._imu_t_ns if self._imu_t_ns is not None else t_ns, q
         )
+        return True
+
+    def on_nav_pos(self, t_ns: int, r_N_m: np.ndarray) -> bool:
+        """One valid navigation position [m, frame N] received at ``t_ns``."""
+        self._nav_r = (t_ns, np.array(r_N_m, dtype=float))
+        return True
+
+    def on_nav_vel(self, t_ns: int, v_N_m_s: np.ndarray) -> bool:
+        """One valid navigation velocity [m/s, frame N] received at ``t_ns``."""
+        self._nav_v = (t_ns, np.array(v_N_m_s, dtype=float))
+        return True
+
+    def on_thr_status(self, t_ns: int, signals: dict[str, Any]) -> None:
+        """One THR_STATUS sample (Cmd/Open/Current flags per thruster)."""
+        self.thr_status = signals
+        if self.thruster_fdir is None:
+            return
+        n = min(len(self.modulators), MAX_THR_STATUS)
+        cmd = np.array([bool(signals.get(f"Cmd_T{k:02d}", 0)) for k in range(n)])
+        opened = np.array([bool(signals.get(f"Open_T{k:02d}", 0)) for k in range(n)])
+        current = np.array([bool(signals.get(f"Current_T{k:02d}", 0)) for k in range(n)])
+        self.thruster_fdir.on_valve_status(t_ns, cmd, opened, current)
+
+    # --- restart ------------------------------------------------------------------------
+
+    def restart(self, t_ns: int, bench_time_ns: int) -> None:
+        """The bench restarted (its time went back to ``bench_time_ns`` at our ``t_ns``)."""
+        if self.make_estimator is not None:
+            self.estimator = self.make_estimator()
+        for stateful in (self.controller, self.translation):
+            reset = getattr(stateful, "reset", None)
+            if callable(reset):
+                reset()  # e.g. an integral term
+        if self.make_modulator is not None:
+            self.modulators = [self.make_modulator() for _ in self.modulators]
+        if self._allocator_full is not None:
+            self.allocator = self._allocator_full
+        if self.thruster_fdir is not None:
+            self.thruster_fdir.reset()
+            self.thruster_fdir.time_base_ns = t_ns - bench_time_ns
+        self.sensor_monitor.reset()
+        self.watchdog.last_ns.clear()
+        self.watchdog.start(t_ns)
+        self.timeline.time_base_ns = t_ns - bench_time_ns
+        self.safe_latched = False
+        self.mode = Mode.BOOT
+        self.imu_counter = 0
+        self._imu_t_ns = self._acc_t_ns = None
+        self._q_hold_BN = self._r_hold_N_m = None
+        self._nav_r = self._nav_v = None
+        self.restarts += 1
+
+    # --- cycle --------------------------------------------------------------------------
+
+    def _reconfigure(self, failures: list[ThrusterFailure]) -> None:
+        """New allocator for the FDIR's mask; restart the failed thrusters' modulators."""
+        assert self.thruster_fdir is not None
+        mask = self.thruster_fdir.mask
+        key = tuple(bool(x) for x in mask)
+        alloc = self.allocators_by_mask.get(key)
+        if alloc is None:
+            base = self._allocator_full or self.allocator
+            alloc = base.with_mask(mask.copy())
+            self.allocators_by_mask[key] = alloc
+        self.allocator = alloc
+        if self.make_modulator is not None:
+            for f in failures:
+                self.modulators[f.thruster] = self.make_modulator()
+
+    def _sensor_flags(self, str_lost: bool) -> int:
+        flags = 0
+        if self.sensor_monitor.frozen("IMU_RATE"):
+            flags |= SensorFlag.IMU_FROZEN
+        if self.sensor_monitor.frozen("STR_QUAT"):
+            flags |= SensorFlag.STR_FROZEN | SensorFlag.STR_DEGRADED
+        if str_lost:
+            flags |= SensorFlag.STR_DEGRADED
+        if self.restarts:
+            flags |= SensorFlag.BENCH_RESTART
+        return flags
+
+    def _nav(self, t_ns: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """The navigation position and velocity if both are fresh."""
+        if self._nav_r is None or self._nav_v is None:
+            return None
+        (t_r, r), (t_v, v) = self._nav_r, self._nav_v
+        if t_ns - t_r > self.nav_timeout_ns or t_ns - t_v > self.nav_timeout_ns:
+            return None
+        return r, v
 
     def cycle(self, t_ns: int) -> CycleResult:
         """Run one control cycle at ``t_ns``; returns the valve on-times for the next period."""
@@ -93,40 +268,97 @@ class FlightComputer:
         if self.watchdog.lost("IMU_RATE", t_ns):
             self.safe_latched = True
             flags |= FdirFlag.IMU_LOST
-        if self.watchdog.lost("STR_QUAT", t_ns):
+        str_lost = self.watchdog.lost("STR_QUAT", t_ns)
+        if str_lost:
             flags |= FdirFlag.STR_LOST
+        sensor_flags = self._sensor_flags(str_lost)
+        if sensor_flags & (SensorFlag.IMU_FROZEN | SensorFlag.STR_FROZEN):
+            flags |= FdirFlag.SENSOR_FROZEN
+        if self.restarts:
+            flags |= FdirFlag.BENCH_RESTART
+        nav = self._nav(t_ns) if self.translation is not None else None
+        if self.translation is not None and nav is None:
+            flags |= FdirFlag.NAV_LOST
+        fdir = self.thruster_fdir
+        report = None
+        if fdir is not None:
+            new = fdir.update(t_ns)
+            if new:
+                self._reconfigure(new)
+            report = fdir.report()
+            if report.detected:
+                flags |= FdirFlag.THRUSTER_FAULT_DETECTED
+            if report.isolated:
+                flags |= FdirFlag.THRUSTER_ISOLATED
         est = self.estimator.estimate()
-        if self.safe_latched:
-            self.mode = Mode.SAFE
-            flags |= FdirFlag.SAFE_LATCHED
+        if self.safe_latched or not est.initialised:
+            if self.safe_latched:
+                self.mode = Mode.SAFE
+                flags |= FdirFlag.SAFE_LATCHED
+            else:
+                self.mode = Mode.BOOT
+            on_idle = (0.0,) * n
+            if fdir is not None:
+                fdir.on_command(t_ns, np.zeros(n))
             return CycleResult(
-                (0.0,) * n, self.mode, flags, False, 0.0, self.imu_counter, (0.0, 0.0, 0.0)
-            )
-        if not est.initialised:
-            self.mode = Mode.BOOT
-            return CycleResult(
-                (0.0,) * n, self.mode, flags, False, 0.0, self.imu_counter, (0.0, 0.0, 0.0)
+                on_idle,
+                self.mode,
+                flags,
+                False,
+                0.0,
+                self.imu_counter,
+                ZERO3,
+                ZERO3,
+                sensor_flags,
+                report,
             )
         self.mode = Mode.NOMINAL
-        if t_ns >= self.timeline.t_start_ns:
-            q_ref = self.timeline.q_target_BN
+        tl = self.timeline
+        if t_ns - tl.time_base_ns >= tl.t_start_ns:
+            q_ref = tl.q_target_BN
         else:
             if self._q_hold_BN is None:
                 self._q_hold_BN = np.array(est.q_BN, dtype=float)
             q_ref = self._q_hold_BN
         torque = self.controller.torque_B_Nm(t_ns, est.q_BN, est.omega_BN_B, q_ref, np.zeros(3))
-        alloc = self.allocator.allocate(torque)
+        force = np.zeros(3)
+        if self.translation is not None:
+            if nav is not None:
+                r, v = nav
+                if tl.r_target_N_m is not None:
+                    r_ref = tl.r_target_N_m
+                else:
+                    if self._r_hold_N_m is None:
+                        self._r_hold_N_m = r.copy()
+                    r_ref = self._r_hold_N_m
+                force = self.translation.force_B_N(t_ns, est.q_BN, r, v, r_ref, np.zeros(3))
+            demand = np.concatenate((force, torque))
+        else:
+            demand = torque
+        if fdir is not None and self.effectiveness is not None:
+            for j in fdir.stuck_open:  # feed-forward: the others counter its known wrench
+                demand = demand - self.effectiveness[:, j] * self.max_thrust_N
+        alloc = self.allocator.allocate(demand)
         period_s = self.control_period_ns / NS_PER_S
+        mask = fdir.mask if fdir is not None else None
         on_times = tuple(
-            mod.on_time_s(t_ns, float(thrust) / self.max_thrust_N, period_s)
-            for mod, thrust in zip(self.modulators, alloc.thrust_N, strict=True)
+            0.0
+            if mask is not None and not mask[k]
+            else mod.on_time_s(t_ns, float(thrust) / self.max_thrust_N, period_s)
+            for k, (mod, thrust) in enumerate(zip(self.modulators, alloc.thrust_N, strict=True))
         )
+        if fdir is not None:
+            fdir.on_command(t_ns, np.array(on_times))
+        r_torque = (demand - alloc.achieved)[-TORQUE_DIM:]
         return CycleResult(
             on_times,
             self.mode,
             flags,
             bool(alloc.saturated),
-            float(alloc.residual_norm),
+            float(np.linalg.norm(r_torque)),
             self.imu_counter,
             (float(torque[0]), float(torque[1]), float(torque[2])),
+            (float(force[0]), float(force[1]), float(force[2])),
+            sensor_flags,
+            report,
         )

@@ -7,6 +7,18 @@ modulator to use, with their parameters. Each strategy is chosen by ``kind`` fro
 registry: a new algorithm is a new file plus one registry line. Every bad value raises
 ConfigError naming the scenario file and the dotted key (``flight_sw.modulator.km``).
 Angles are converted to radians here.
+
+Optional tables of ``flight_sw`` (issue 4):
+- ``translation`` (``kind`` from :data:`TRANSLATION_CONTROLLERS`): makes the vehicle 6-DoF;
+  the allocator then gets the 6 wrench rows (force, torque) instead of the 3 torque rows.
+  ``r_target_N_m`` (optional) is the position to hold, else the first navigation fix.
+- ``thruster_fdir``: one sub-table per strategy of :data:`THRUSTER_FDIR`
+  (``[flight_sw.thruster_fdir.valve_status]``, ``[flight_sw.thruster_fdir.rate_residual]``)
+  with its parameters, and ``precompute_masks`` (default true: the allocators for every
+  single-thruster mask are built at start-up, so a reconfiguration costs nothing in the
+  cycle; ≈ 0.2 s each for 16 thrusters and 6 rows).
+- ``sensor_fdir`` (``kind`` from :data:`SENSOR_FDIR`): frozen-sensor counts; defaults
+  apply when absent.
 """
 
 from __future__ import annotations
@@ -24,12 +36,19 @@ from dbc.schema import Table
 from flight_sw.allocation.base import Allocator
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
-from flight_sw.computer import FlightComputer, Timeline
-from flight_sw.control.base import AttitudeController
+from flight_sw.computer import DEFAULT_NAV_TIMEOUT_NS, FlightComputer, Timeline
+from flight_sw.control.base import AttitudeController, TranslationController
+from flight_sw.control.position_pd import PositionPd, PositionPdParams
 from flight_sw.control.quaternion_pd import QuaternionPd, QuaternionPdParams
+from flight_sw.control.quaternion_pid import QuaternionPid, QuaternionPidParams
 from flight_sw.estimation.base import AttitudeEstimator
 from flight_sw.estimation.mekf import Mekf, MekfParams
-from flight_sw.fdir.sensor_watchdog import SensorWatchdog
+from flight_sw.fdir.base import ThrusterFdirStrategy
+from flight_sw.fdir.frozen_sensor import FrozenSensorMonitor, FrozenSensorParams
+from flight_sw.fdir.rate_residual import RateResidualFdir, RateResidualParams
+from flight_sw.fdir.sensor_watchdog import LOST_AFTER_PERIODS, SensorWatchdog
+from flight_sw.fdir.thruster_fdir import ThrusterFdir
+from flight_sw.fdir.valve_status import ValveStatusFdir, ValveStatusParams
 from flight_sw.modulation.base import Modulator
 from flight_sw.modulation.pwpf import PwpfModulator, PwpfParams
 
@@ -38,6 +57,7 @@ ARCSEC_RAD = DEG_RAD / 3600.0
 SQRT_HOUR_S = 60.0
 NS_PER_S = 1_000_000_000
 TORQUE_ROWS = slice(3, 6)
+WRENCH_ROWS = slice(0, 6)
 
 
 class Vehicle:
@@ -56,6 +76,10 @@ class Vehicle:
             x.done()
         self.max_thrust_N = root.number("max_thrust_N", lo=0.0, lo_open=True)
         self.min_on_s = root.number("min_on_s", lo=0.0)
+        self.effectiveness = effectiveness_matrix(self.r_thr_B_m, self.d_thr_B)
+        self.demand_rows = TORQUE_ROWS  # WRENCH_ROWS once a translation controller is set
+        self.control_period_ns = 0
+        self.imu_period_ns = 0
 
 
 def _mekf(t: Table, v: Vehicle) -> AttitudeEstimator:
@@ -79,31 +103,130 @@ def _mekf(t: Table, v: Vehicle) -> AttitudeEstimator:
     )
 
 
-def _quaternion_pd(t: Table, v: Vehicle) -> AttitudeController:
+def _quaternion_pd_params(t: Table, v: Vehicle) -> QuaternionPdParams:
     max_rate = (
         t.number("max_rate_deg_s", lo=0.0, lo_open=True) * DEG_RAD
         if t.has("max_rate_deg_s")
         else math.inf
     )
     if t.has("kp_Nm"):
-        params = QuaternionPdParams(
+        return QuaternionPdParams(
             kp_Nm=t.vector3("kp_Nm"),
             kd_Nms=t.vector3("kd_Nms"),
             max_rate_rad_s=max_rate,
         )
-    else:
-        params = QuaternionPdParams.from_bandwidth(
-            np.diag(v.inertia_B_kgm2).tolist(),
-            t.number("natural_frequency_rad_s", lo=0.0, lo_open=True),
-            t.number("damping_ratio", lo=0.0),
-            max_rate,
+    return QuaternionPdParams.from_bandwidth(
+        np.diag(v.inertia_B_kgm2).tolist(),
+        t.number("natural_frequency_rad_s", lo=0.0, lo_open=True),
+        t.number("damping_ratio", lo=0.0),
+        max_rate,
+    )
+
+
+def _quaternion_pd(t: Table, v: Vehicle) -> AttitudeController:
+    return QuaternionPd(_quaternion_pd_params(t, v))
+
+
+def _quaternion_pid(t: Table, v: Vehicle) -> AttitudeController:
+    return QuaternionPid(
+        QuaternionPidParams(
+            pd=_quaternion_pd_params(t, v),
+            integral_time_s=t.number("integral_time_s", lo=0.0, lo_open=True),
+            integral_band_rad=t.number("integral_band_deg", 2.0, lo=0.0, lo_open=True) * DEG_RAD,
+            max_integral_torque_Nm=t.number(
+                "max_integral_torque_Nm", math.inf, lo=0.0, lo_open=True
+            )
+            if t.has("max_integral_torque_Nm")
+            else math.inf,
         )
-    return QuaternionPd(params)
+    )
 
 
 def _pseudo_inverse(t: Table, v: Vehicle) -> Allocator:
-    b = effectiveness_matrix(v.r_thr_B_m, v.d_thr_B)[TORQUE_ROWS]
+    b = v.effectiveness[v.demand_rows]
     return PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_N=v.max_thrust_N))
+
+
+def _position_pd(t: Table, v: Vehicle) -> tuple[TranslationController, np.ndarray | None]:
+    max_force = t.number("max_force_N", lo=0.0, lo_open=True) if t.has("max_force_N") else math.inf
+    max_speed = (
+        t.number("max_speed_m_s", lo=0.0, lo_open=True) if t.has("max_speed_m_s") else math.inf
+    )
+    if t.has("kp_N_m"):
+        params = PositionPdParams(t.vector3("kp_N_m"), t.vector3("kd_N_s_m"), max_force, max_speed)
+    else:
+        params = PositionPdParams.from_bandwidth(
+            v.mass_kg,
+            t.number("natural_frequency_rad_s", lo=0.0, lo_open=True),
+            t.number("damping_ratio", lo=0.0),
+            max_force,
+            max_speed,
+        )
+    r_target = np.array(t.vector3("r_target_N_m")) if t.has("r_target_N_m") else None
+    return PositionPd(params), r_target
+
+
+def _valve_status(t: Table, v: Vehicle) -> ThrusterFdirStrategy:
+    d = ValveStatusParams()
+    params = ValveStatusParams(
+        stuck_closed_samples=t.integer("stuck_closed_samples", d.stuck_closed_samples, lo=1),
+        window_samples=t.integer("window_samples", d.window_samples, lo=1),
+        stuck_open_samples=t.integer("stuck_open_samples", d.stuck_open_samples, lo=1),
+        quiet_cycles=t.integer("quiet_cycles", d.quiet_cycles, lo=1),
+    )
+    return ValveStatusFdir(len(v.r_thr_B_m), params)
+
+
+def _rate_residual(t: Table, v: Vehicle) -> ThrusterFdirStrategy:
+    d = RateResidualParams()
+    use_accel = t.raw("use_accel", d.use_accel)
+    if not isinstance(use_accel, bool):
+        raise t.error("use_accel", use_accel, "true or false")
+    params = RateResidualParams(
+        window_s=t.number("window_s", d.window_s, lo=0.0, lo_open=True),
+        threshold=t.number("threshold", d.threshold, lo=0.0, lo_open=True),
+        glr_threshold=t.number("glr_threshold", d.glr_threshold, lo=0.0, lo_open=True),
+        persistence_cycles=t.integer("persistence_cycles", d.persistence_cycles, lo=1),
+        isolation_cycles=t.integer("isolation_cycles", d.isolation_cycles, lo=1),
+        explained_fraction=t.number(
+            "explained_fraction", d.explained_fraction, lo=0.0, lo_open=True, hi=1.0
+        ),
+        isolation_margin=t.number("isolation_margin", d.isolation_margin, lo=0.0),
+        command_delay_s=t.number("command_delay_s", d.command_delay_s, lo=0.0),
+        valve_open_delay_s=t.number("valve_open_delay_s", d.valve_open_delay_s, lo=0.0),
+        valve_close_delay_s=t.number("valve_close_delay_s", d.valve_close_delay_s, lo=0.0),
+        valve_rise_tau_s=t.number("valve_rise_tau_s", d.valve_rise_tau_s, lo=0.0),
+        valve_tail_tau_s=t.number("valve_tail_tau_s", d.valve_tail_tau_s, lo=0.0),
+        edge_uncertainty_s=t.number("edge_uncertainty_s", d.edge_uncertainty_s, lo=0.0),
+        gyro_noise_rad_s=t.number("gyro_noise_rad_s", d.gyro_noise_rad_s, lo=0.0, lo_open=True),
+        accel_noise_m_s2=t.number("accel_noise_m_s2", d.accel_noise_m_s2, lo=0.0, lo_open=True),
+        accel_bias_m_s2=t.number("accel_bias_m_s2", d.accel_bias_m_s2, lo=0.0),
+        model_rel_error=t.number("model_rel_error", d.model_rel_error, lo=0.0),
+        thrust_rel_error=t.number("thrust_rel_error", d.thrust_rel_error, lo=0.0),
+        bias_time_constant_s=t.number(
+            "bias_time_constant_s", d.bias_time_constant_s, lo=0.0, lo_open=True
+        ),
+        use_accel=use_accel,
+    )
+    return RateResidualFdir(
+        v.effectiveness,
+        v.inertia_B_kgm2,
+        v.mass_kg,
+        v.max_thrust_N,
+        v.min_on_s,
+        v.control_period_ns,
+        v.imu_period_ns,
+        params,
+    )
+
+
+def _frozen_value(t: Table, v: Vehicle) -> FrozenSensorMonitor:
+    d = FrozenSensorParams()
+    params = FrozenSensorParams(
+        imu_rate_samples=t.integer("imu_rate_samples", d.imu_rate_samples, lo=2),
+        str_quat_samples=t.integer("str_quat_samples", d.str_quat_samples, lo=2),
+    )
+    return FrozenSensorMonitor(params.by_message())
 
 
 def _pwpf(t: Table, v: Vehicle) -> Callable[[], Modulator]:
@@ -119,17 +242,27 @@ def _pwpf(t: Table, v: Vehicle) -> Callable[[], Modulator]:
 
 ESTIMATORS: dict[str, Callable[[Table, Vehicle], AttitudeEstimator]] = {"mekf": _mekf}
 CONTROLLERS: dict[str, Callable[[Table, Vehicle], AttitudeController]] = {
-    "quaternion_pd": _quaternion_pd
+    "quaternion_pd": _quaternion_pd,
+    "quaternion_pid": _quaternion_pid,
 }
 ALLOCATORS: dict[str, Callable[[Table, Vehicle], Allocator]] = {"pseudo_inverse": _pseudo_inverse}
 MODULATORS: dict[str, Callable[[Table, Vehicle], Callable[[], Modulator]]] = {"pwpf": _pwpf}
+TRANSLATION_CONTROLLERS: dict[
+    str, Callable[[Table, Vehicle], tuple[TranslationController, np.ndarray | None]]
+] = {"position_pd": _position_pd}
+# Strategies run in this order (the first to isolate in a cycle wins).
+THRUSTER_FDIR: dict[str, Callable[[Table, Vehicle], ThrusterFdirStrategy]] = {
+    "valve_status": _valve_status,
+    "rate_residual": _rate_residual,
+}
+SENSOR_FDIR: dict[str, Callable[[Table, Vehicle], FrozenSensorMonitor]] = {
+    "frozen_value": _frozen_value
+}
 
 
-def _strategy(parent: Table, key: str, registry: dict[str, Any], v: Vehicle) -> Any:
-    t = parent.table(key)
-    kind = t.string("kind", choices=tuple(registry))
+def _build(t: Table, builder: Callable[[Table, Vehicle], Any], v: Vehicle) -> Any:
     try:
-        built = registry[kind](t, v)
+        built = builder(t, v)
     except ConfigError as exc:
         if exc.source == t.source:
             raise
@@ -137,6 +270,40 @@ def _strategy(parent: Table, key: str, registry: dict[str, Any], v: Vehicle) -> 
         raise ConfigError(t.source, f"{t.path}.{exc.key}", exc.value, exc.expected) from exc
     t.done()
     return built
+
+
+def _strategy(parent: Table, key: str, registry: dict[str, Any], v: Vehicle) -> Any:
+    t = parent.table(key)
+    kind = t.string("kind", choices=tuple(registry))
+    return _build(t, registry[kind], v)
+
+
+def _thruster_fdir(parent: Table, v: Vehicle) -> tuple[ThrusterFdir | None, bool]:
+    """The thruster FDIR of ``[flight_sw.thruster_fdir]`` (None if absent), precompute flag."""
+    if not parent.has("thruster_fdir"):
+        return None, False
+    t = parent.table("thruster_fdir")
+    precompute = t.raw("precompute_masks", True)
+    if not isinstance(precompute, bool):
+        raise t.error("precompute_masks", precompute, "true or false")
+    names = [name for name in THRUSTER_FDIR if t.has(name)]
+    strategies = [_build(t.table(name), THRUSTER_FDIR[name], v) for name in names]
+    t.done()
+    if not strategies:
+        raise parent.error(
+            "thruster_fdir", {}, "a table naming at least one of " + ", ".join(THRUSTER_FDIR)
+        )
+    return ThrusterFdir(len(v.r_thr_B_m), strategies), precompute
+
+
+def _single_failure_allocators(alloc: Allocator, n: int) -> dict[tuple[bool, ...], Allocator]:
+    """Allocators for every mask with one thruster removed."""
+    out: dict[tuple[bool, ...], Allocator] = {}
+    for k in range(n):
+        mask = np.ones(n, dtype=bool)
+        mask[k] = False
+        out[tuple(bool(x) for x in mask)] = alloc.with_mask(mask)
+    return out
 
 
 def build_computer(
@@ -156,23 +323,56 @@ def build_computer(
         raise man.error("q_target_BN", q_target.tolist(), "a unit quaternion")
     t_start_ns = round(man.number("t_start_s", lo=0.0) * NS_PER_S)
     man.done()
+    vehicle.control_period_ns = control_period_ns
+    vehicle.imu_period_ns = imu_period_ns
     fsw = root.table("flight_sw", {})
+    est_table = fsw.raw("estimator", None)
     estimator = _strategy(fsw, "estimator", ESTIMATORS, vehicle)
     controller = _strategy(fsw, "controller", CONTROLLERS, vehicle)
+    translation, r_target = None, None
+    if fsw.has("translation"):
+        translation, r_target = _strategy(fsw, "translation", TRANSLATION_CONTROLLERS, vehicle)
+        vehicle.demand_rows = WRENCH_ROWS
     allocator = _strategy(fsw, "allocator", ALLOCATORS, vehicle)
     make_modulator = _strategy(fsw, "modulator", MODULATORS, vehicle)
+    thruster_fdir, precompute = _thruster_fdir(fsw, vehicle)
+    if fsw.has("sensor_fdir"):
+        monitor = _strategy(fsw, "sensor_fdir", SENSOR_FDIR, vehicle)
+    else:
+        monitor = FrozenSensorMonitor(FrozenSensorParams().by_message())
     fsw.done()
     root.done()
+    n = len(vehicle.r_thr_B_m)
+    by_mask = _single_failure_allocators(allocator, n) if precompute else {}
+
+    def make_estimator() -> AttitudeEstimator:
+        # the table was validated above; rebuilding it cannot fail
+        built: AttitudeEstimator = _strategy(
+            Table({"estimator": est_table}, source), "estimator", ESTIMATORS, vehicle
+        )
+        return built
+
+    nav_period = watch_periods_ns.get("NAV_POS")
     return FlightComputer(
         estimator=estimator,
         controller=controller,
         allocator=allocator,
-        modulators=[make_modulator() for _ in range(len(vehicle.r_thr_B_m))],
+        modulators=[make_modulator() for _ in range(n)],
         max_thrust_N=vehicle.max_thrust_N,
         control_period_ns=control_period_ns,
         imu_period_ns=imu_period_ns,
-        timeline=Timeline(q_target, t_start_ns),
-        watchdog=SensorWatchdog(watch_periods_ns),
+        timeline=Timeline(q_target, t_start_ns, r_target),
+        watchdog=SensorWatchdog(
+            {k: p for k, p in watch_periods_ns.items() if k in ("IMU_RATE", "STR_QUAT")}
+        ),
+        translation=translation,
+        effectiveness=vehicle.effectiveness[vehicle.demand_rows].copy(),
+        thruster_fdir=thruster_fdir,
+        sensor_monitor=monitor,
+        make_estimator=make_estimator,
+        make_modulator=make_modulator,
+        allocators_by_mask=by_mask,
+        nav_timeout_ns=(LOST_AFTER_PERIODS * nav_period if nav_period else DEFAULT_NAV_TIMEOUT_NS),
     )
 
 

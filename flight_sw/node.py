@@ -2,9 +2,18 @@
 
 Frames in (checked on receipt by :class:`dbc.codec.FrameChecker`: ID, DLC, CRC, alive
 counter, range; freshness of SYNC by its cycle number): SYNC, IMU_RATE, IMU_ACCEL,
-STR_QUAT, THR_STATUS, BENCH_STATUS. Frames out: FSW_STATUS (also the boot heartbeat),
-FSW_ATT_EST, THR_CMD_0..3 (on-times of 4 thrusters each, the cycle number and the newest
-IMU_RATE counter used).
+STR_QUAT, NAV_POS, NAV_VEL, THR_STATUS, BENCH_STATUS. Frames out: FSW_STATUS (also the boot
+heartbeat), FSW_ATT_EST, FSW_FDIR, THR_CMD_0..3 (on-times of 4 thrusters each, the cycle
+number and the newest IMU_RATE counter used).
+
+Bench restart: a SYNC whose cycle goes back to 0 (or more than ``STALE_SYNC_WINDOW`` cycles
+back), or a BENCH_STATUS whose SimTime goes backwards, means the bench started a new run:
+the flight computer is re-initialised on the bench's new time
+(:meth:`FlightComputer.restart`), the cycle bookkeeping starts again and the new SYNC is
+answered (never a hang). A SYNC one or two cycles back is a stale frame, rejected.
+In realtime the flight computer's manoeuvre time is aligned on the first BENCH_STATUS.
+Heartbeat: FSW_STATUS alone at start-up and after every second without any received frame
+(before the first SYNC, or when the bench has gone), so a restarted bench finds us.
 
 Modes: ``lockstep`` — one control cycle per SYNC(k), at the simulation time it carries;
 ``realtime`` — cycles on this process's own monotonic timer (period from the DBC), with
@@ -30,6 +39,7 @@ from dbc.codec import Decoded, Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 from flight_sw.clock import MonotonicClock
 from flight_sw.computer import CycleResult, FlightComputer
+from flight_sw.fdir.base import NO_THRUSTER
 
 THRUSTERS_PER_CMD_FRAME = 4
 HEARTBEAT_RETRY_S = 1.0
@@ -37,11 +47,28 @@ CYCLE_MODULUS = 256
 STATUS_CYCLE_MODULUS = 65536
 OVERRUN_MAX = 255
 ON_TIME_LSB_S = 1e-4
+# A full-period pulse is sent this much longer, to bridge command-arrival jitter (see
+# ``send_commands``); far below the DBC's 102.3 ms and the bench's valve watchdog.
+FULL_ON_OVERLAP_S = 0.005
 MS_PER_S = 1000
 NS_PER_MS = 1_000_000
 BENCH_FRAMES = frozenset(
-    {"SYNC", "IMU_RATE", "IMU_ACCEL", "STR_QUAT", "THR_STATUS", "BENCH_STATUS"}
+    {
+        "SYNC",
+        "IMU_RATE",
+        "IMU_ACCEL",
+        "STR_QUAT",
+        "NAV_POS",
+        "NAV_VEL",
+        "THR_STATUS",
+        "BENCH_STATUS",
+    }
 )
+# A SYNC at most this many cycles behind the last one is stale; further back, a restart.
+STALE_SYNC_WINDOW = 2
+DETECTION_TIME_MAX_S = 655.35  # FSW_FDIR.DetectionTime range
+ISOLATION_DELAY_MAX_S = 2.55  # FSW_FDIR.IsolationDelay range
+ALLOC_RESIDUAL_MAX_NM = 12.75  # FSW_STATUS.AllocResidual range
 
 
 def _percentiles_us(samples_ns: list[int]) -> dict[str, float | int | None]:
@@ -68,6 +95,7 @@ class NodeStats:
 
     cycles: int = 0
     overruns: int = 0
+    restarts: int = 0
     sent: dict[str, int] = field(default_factory=dict)
     cycle_ns: list[int] = field(default_factory=list)  # cycle start -> last frame sent
 
@@ -101,6 +129,10 @@ class FlightNode:
         self._last_flags = 0
         self._last_sat = False
         self._last_residual = 0.0
+        self._last_result: CycleResult | None = None
+        self._bench_time_ns: int | None = None  # newest BENCH_STATUS SimTime
+        self._realtime = False
+        self._time_aligned = False
 
     # -- signals -----------------------------------------------------------------
     def install_signal_handlers(self) -> None:
@@ -131,7 +163,7 @@ class FlightNode:
         self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
 
     def send_status(self, cycle: int) -> None:
-        """FSW_STATUS and FSW_ATT_EST."""
+        """FSW_STATUS, FSW_ATT_EST and FSW_FDIR."""
         fc = self.fc
         self._send(
             "FSW_STATUS",
@@ -141,15 +173,45 @@ class FlightNode:
                 "Overruns": min(self.stats.overruns, OVERRUN_MAX),
                 "FdirFlags": self._last_flags,
                 "AllocSaturated": int(self._last_sat),
-                "AllocResidual": min(self._last_residual, 12.75),
+                "AllocResidual": min(self._last_residual, ALLOC_RESIDUAL_MAX_NM),
             },
         )
         est = fc.estimator.estimate()
         q = [float(x) for x in est.q_BN]
         self._send("FSW_ATT_EST", {"Valid": int(est.initialised), **pack_quaternion(q)})
+        self._send("FSW_FDIR", self._fdir_signals())
+
+    def _fdir_signals(self) -> dict[str, float | int]:
+        """FSW_FDIR from the last cycle (all thrusters available before the first cycle)."""
+        res = self._last_result
+        rep = res.fdir if res is not None else None
+        if rep is None:
+            return {
+                "AvailableMask": (1 << self.n_thr) - 1,
+                "FailedThruster": NO_THRUSTER,
+                "FailureKind": 0,
+                "DetectionTime": 0.0,
+                "IsolationDelay": 0.0,
+                "SensorFlags": res.sensor_flags if res is not None else 0,
+            }
+        return {
+            "AvailableMask": rep.available_mask,
+            "FailedThruster": rep.failed_thruster,
+            "FailureKind": int(rep.failure_kind),
+            "DetectionTime": min(max(rep.detection_time_s, 0.0), DETECTION_TIME_MAX_S),
+            "IsolationDelay": min(max(rep.isolation_delay_s, 0.0), ISOLATION_DELAY_MAX_S),
+            "SensorFlags": res.sensor_flags if res is not None else 0,
+        }
 
     def send_commands(self, cycle: int, res: CycleResult) -> None:
-        """THR_CMD_0..m for one cycle (thrusters beyond the vehicle's count are 0)."""
+        """THR_CMD_0..m for one cycle (thrusters beyond the vehicle's count are 0).
+
+        A full-period on-time is sent ``FULL_ON_OVERLAP_S`` longer, so that consecutive
+        full-on pulses overlap the next command, which continues the energised coil: no
+        closing and re-opening transient when a command arrives a little later than the
+        previous one (e.g. behind the status frames). The next command always ends or
+        continues it, so the thrust is that of a continuous pulse.
+        """
         max_on = self.period_ns / 1e9
         for f in range(self.n_cmd_frames):
             sig: dict[str, float | int] = {
@@ -158,10 +220,10 @@ class FlightNode:
             }
             for j in range(THRUSTERS_PER_CMD_FRAME):
                 k = f * THRUSTERS_PER_CMD_FRAME + j
-                on = res.on_time_s[k] if k < self.n_thr else 0.0
-                sig[f"OnTime_T{k:02d}"] = (
-                    round(min(max(on, 0.0), max_on) / ON_TIME_LSB_S) * ON_TIME_LSB_S
-                )
+                on = min(max(res.on_time_s[k] if k < self.n_thr else 0.0, 0.0), max_on)
+                if on >= max_on:
+                    on = max_on + FULL_ON_OVERLAP_S
+                sig[f"OnTime_T{k:02d}"] = round(on / ON_TIME_LSB_S) * ON_TIME_LSB_S
             self._send(f"THR_CMD_{f}", sig)
 
     def run_cycle(self, cycle: int, t_ns: int) -> None:
@@ -172,6 +234,7 @@ class FlightNode:
 
     def _cycle_frames(self, cycle: int, t_ns: int) -> None:
         res = self.fc.cycle(t_ns)
+        self._last_result = res
         self._last_flags, self._last_sat, self._last_residual = (
             res.fdir_flags,
             res.saturated,
@@ -186,29 +249,72 @@ class FlightNode:
     def handle(self, d: Decoded, t_ns: int) -> None:
         """Feed one checked sensor frame to the computer, stamped ``t_ns``."""
         s = d.signals
-        if d.name == "IMU_RATE":
+        fc = self.fc
+        name = d.name
+        if name == "IMU_RATE":
+            if s["Valid"] and fc.on_imu_rate(
+                t_ns, np.array((s["RateX"], s["RateY"], s["RateZ"])), d.counter, d.gap
+            ):
+                self._pending_seen.add(name)
+        elif name == "IMU_ACCEL":
             if s["Valid"]:
-                self.fc.on_imu_rate(
-                    t_ns, np.array((s["RateX"], s["RateY"], s["RateZ"])), d.counter, d.gap
+                fc.on_imu_accel(
+                    t_ns, np.array((s["AccelX"], s["AccelY"], s["AccelZ"])), d.counter, d.gap
                 )
-                self._pending_seen.add("IMU_RATE")
-        elif d.name == "STR_QUAT":
+        elif name == "STR_QUAT":
+            payload = (s["Largest"], s["C0"], s["C1"], s["C2"])
+            if s["Valid"] and fc.on_star_tracker(t_ns, np.array(unpack_quaternion(s)), payload):
+                self._pending_seen.add(name)
+        elif name == "NAV_POS":
             if s["Valid"]:
-                self.fc.on_star_tracker(t_ns, np.array(unpack_quaternion(s)))
-                self._pending_seen.add("STR_QUAT")
-        elif d.name == "THR_STATUS":
-            self.fc.thr_status = s
+                fc.on_nav_pos(t_ns, np.array((s["PosX"], s["PosY"], s["PosZ"])))
+        elif name == "NAV_VEL":
+            if s["Valid"]:
+                fc.on_nav_vel(t_ns, np.array((s["VelX"], s["VelY"], s["VelZ"])))
+        elif name == "THR_STATUS":
+            fc.on_thr_status(t_ns, s)
+        elif name == "BENCH_STATUS":
+            self._on_bench_time(round(float(s["SimTime"]) * MS_PER_S) * NS_PER_MS, t_ns)
+
+    def _on_bench_time(self, bench_ns: int, t_ns: int) -> None:
+        """BENCH_STATUS SimTime: a step back is a bench restart; realtime aligns on the first."""
+        last = self._bench_time_ns
+        self._bench_time_ns = bench_ns
+        if last is not None and bench_ns < last:
+            now = self.clock.now_ns() if self._realtime else bench_ns
+            self.bench_restarted(now, bench_ns)
+            self._bench_time_ns = bench_ns
+        elif self._realtime and not self._time_aligned:
+            self.fc.timeline.time_base_ns = self.clock.now_ns() - bench_ns
+            if self.fc.thruster_fdir is not None:
+                self.fc.thruster_fdir.time_base_ns = self.fc.timeline.time_base_ns
+            self._time_aligned = True
+
+    def bench_restarted(self, t_ns: int, bench_ns: int) -> None:
+        """Start again with a restarted bench: our time ``t_ns`` is its time ``bench_ns``."""
+        self.fc.restart(t_ns, bench_ns)
+        self.stats.restarts += 1
+        self._last_sync = None
+        self._sync_cycle = -1
+        self._bench_time_ns = None
+        self._pending_seen.clear()
+        self._time_aligned = self._realtime
 
     def _heartbeat(self) -> None:
+        """FSW_STATUS alone: BOOT before the first cycle, else the current state.
+
+        Sent at start-up and after every second without any frame (before the first SYNC,
+        or when the bench has gone: a restarted bench waits for this frame to start).
+        """
         self._send(
             "FSW_STATUS",
             {
-                "Mode": 0,
-                "Cycle": 0,
-                "Overruns": 0,
-                "FdirFlags": 0,
-                "AllocSaturated": 0,
-                "AllocResidual": 0.0,
+                "Mode": int(self.fc.mode),
+                "Cycle": self.stats.cycles % STATUS_CYCLE_MODULUS,
+                "Overruns": min(self.stats.overruns, OVERRUN_MAX),
+                "FdirFlags": self._last_flags,
+                "AllocSaturated": int(self._last_sat),
+                "AllocResidual": min(self._last_residual, ALLOC_RESIDUAL_MAX_NM),
             },
         )
 
@@ -216,12 +322,10 @@ class FlightNode:
     def run_lockstep(self) -> None:
         """Cycle on SYNC frames until stopped."""
         self._heartbeat()
-        synced = False
         while not self._stop:
             msg = self.bus.recv(timeout=HEARTBEAT_RETRY_S)
             if msg is None:
-                if not synced:
-                    self._heartbeat()
+                self._heartbeat()
                 continue
             d = self.checker.check(msg)
             if d is None:
@@ -230,11 +334,13 @@ class FlightNode:
                 self.handle(d, self._last_sync or 0)
                 continue
             cycle = int(d.signals["Cycle"])
-            if self._last_sync is not None and cycle <= self._sync_cycle:
-                self.checker.reject("SYNC", Reject.STALE)
-                continue
-            synced = True
             t_ns = round(float(d.signals["SimTime"]) * MS_PER_S) * NS_PER_MS
+            if self._last_sync is not None and cycle <= self._sync_cycle:
+                if cycle == 0 or self._sync_cycle - cycle > STALE_SYNC_WINDOW:
+                    self.bench_restarted(t_ns, t_ns)
+                else:
+                    self.checker.reject("SYNC", Reject.STALE)
+                    continue
             if self._last_sync is None:
                 self.fc.watchdog.start(t_ns)
             for name in self._pending_seen:
@@ -247,6 +353,7 @@ class FlightNode:
     def run_realtime(self) -> None:
         """Cycle on this process's own timer until stopped."""
         clock = self.clock
+        self._realtime = True
         self._heartbeat()
         period = self.period_ns
         next_ns = clock.now_ns() + period
@@ -276,6 +383,31 @@ class FlightNode:
                 self.write_stats()
         self.write_stats()
 
+    def _fdir_stats(self) -> dict[str, Any]:
+        """Isolated thruster failures (times relative to the bench's time 0) and flags."""
+        fc = self.fc
+        res = self._last_result
+        out: dict[str, Any] = {
+            "sensor_flags": res.sensor_flags if res is not None else 0,
+            "fdir_flags": res.fdir_flags if res is not None else 0,
+            "failures": [],
+        }
+        fdir = fc.thruster_fdir
+        if fdir is not None:
+            base = fdir.time_base_ns
+            out["available_mask"] = int(sum(1 << k for k in range(fdir.n) if fdir.mask[k]))
+            out["failures"] = [
+                {
+                    "thruster": f.thruster,
+                    "kind": f.kind.name.lower(),
+                    "t_detect_s": (f.t_detect_ns - base) / 1e9,
+                    "t_isolate_s": (f.t_isolate_ns - base) / 1e9,
+                    "source": f.source,
+                }
+                for f in fdir.failures
+            ]
+        return out
+
     def write_stats(self) -> None:
         """Write the node's statistics JSON (atomically) if a path was given."""
         if self.stats_path is None:
@@ -287,6 +419,8 @@ class FlightNode:
             "received": self.checker.summary(),
             "mode": self.fc.mode.name,
             "cycle_time_us": _percentiles_us(self.stats.cycle_ns),
+            "restarts": self.stats.restarts,
+            "fdir": self._fdir_stats(),
         }
         tmp = self.stats_path.with_suffix(".tmp")
         tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")

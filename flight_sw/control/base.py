@@ -1,7 +1,9 @@
-"""The attitude controller interface: estimated and reference attitude/rate in, body torque out.
+"""The controller interfaces: attitude (torque out) and translation (force out), body axes.
 
 What it does: defines :class:`AttitudeController`, the one interface every attitude
-control strategy implements.
+control strategy implements, and :class:`TranslationController`, the one every
+translation (position) control strategy of a 6-DoF configuration implements (its
+inputs and output are in its own docstring). Below: the attitude interface.
 
 Inputs: ``t_ns`` [integer ns, the caller's time base; strategies without memory ignore
 it]; ``q_BN`` the (estimated) attitude, scalar-first, maps inertial N to body B;
@@ -36,4 +38,28 @@ class AttitudeController(Protocol):
         omega_RN_B: np.ndarray,
     ) -> np.ndarray:
         """The demanded torque in body axes [N m], shape (3,)."""
+        ...
+
+
+class TranslationController(Protocol):
+    """A translation control law producing a body-axes force demand (6-DoF runs).
+
+    Inputs: ``t_ns`` [integer ns]; ``q_BN`` the estimated attitude (scalar-first, maps the
+    navigation frame N to body B), used to express the force in body axes;
+    ``r_N_m``/``v_N_m_s`` the measured position [m] and velocity [m/s] of the vehicle in
+    the navigation frame N (inertial, or the Hill frame of a relative-navigation sensor);
+    ``r_ref_N_m``/``v_ref_N_m_s`` the reference position and velocity in N.
+    Output: the demanded control force on the vehicle in body axes [N], shape (3,).
+    """
+
+    def force_B_N(
+        self,
+        t_ns: int,
+        q_BN: np.ndarray,
+        r_N_m: np.ndarray,
+        v_N_m_s: np.ndarray,
+        r_ref_N_m: np.ndarray,
+        v_ref_N_m_s: np.ndarray,
+    ) -> np.ndarray:
+        """The demanded force in body axes [N], shape (3,)."""
         ...

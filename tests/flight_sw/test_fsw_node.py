@@ -1,8 +1,10 @@
 """The flight-software process logic over a real python-can bus (virtual, in-process).
 
 A scripted bench on the other end sends sensor frames and SYNCs; the node must answer each
-SYNC with THR_CMD frames for that cycle, reject stale SYNCs, and go to SAFE mode (all valves
-closed) when IMU frames stop for 3 of their periods.
+SYNC with THR_CMD frames for that cycle, reject stale SYNCs, go to SAFE mode (all valves
+closed) when IMU frames stop for 3 of their periods, report FSW_FDIR with each status, and
+start again cleanly when the bench restarts (SYNC back to 0, or BENCH_STATUS time going
+backwards).
 """
 
 from __future__ import annotations
@@ -21,14 +23,17 @@ from dbc import load_database
 from dbc.codec import Encoder, FrameChecker, cycle_time_ns
 from dbc.quaternion import pack_quaternion
 from flight_sw.config import build_computer
-from flight_sw.modes import FdirFlag, Mode
-from flight_sw.node import FlightNode
+from flight_sw.modes import FdirFlag, Mode, SensorFlag
+from flight_sw.node import FULL_ON_OVERLAP_S, FlightNode
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 RECV_TIMEOUT_S = 5.0
 PERIOD_S = 0.02
 IMU_PER_CYCLE = 2
 SAFE_AFTER_CYCLES = 2  # 3 IMU periods (30 ms) of silence are over within 2 control cycles
+FULL_ON_S = PERIOD_S + FULL_ON_OVERLAP_S
+GYRO_LSB_RAD_S = 2e-5  # the scripted gyro steps by one LSB per sample (a live sensor)
+HEARTBEAT_WAIT_S = 3.0  # the node repeats FSW_STATUS after 1 s without frames
 
 
 class Bench:
@@ -39,8 +44,10 @@ class Bench:
         self.bus = bus
         self.enc = Encoder(self.db)
         self.chk = FrameChecker(
-            self.db, accept=frozenset({"THR_CMD_0", "THR_CMD_1", "FSW_STATUS", "FSW_ATT_EST"})
+            self.db,
+            accept=frozenset({"THR_CMD_0", "THR_CMD_1", "FSW_STATUS", "FSW_ATT_EST", "FSW_FDIR"}),
         )
+        self.n_imu = 0
 
     def send(self, name: str, sig: dict[str, Any]) -> None:
         self.bus.send(self.enc.message(name, sig))
@@ -48,8 +55,16 @@ class Bench:
     def sensors(self, imu: bool = True) -> None:
         if imu:
             for _ in range(IMU_PER_CYCLE):
-                self.send("IMU_RATE", {"Valid": 1, "RateX": 0.0, "RateY": 0.0, "RateZ": 0.0})
+                self.n_imu += 1
+                rate = (self.n_imu % 7) * GYRO_LSB_RAD_S
+                self.send("IMU_RATE", {"Valid": 1, "RateX": rate, "RateY": 0.0, "RateZ": 0.0})
         self.send("STR_QUAT", {"Valid": 1, **pack_quaternion((1.0, 0.0, 0.0, 0.0))})
+
+    def bench_status(self, sim_time_s: float) -> None:
+        self.send(
+            "BENCH_STATUS",
+            {"SimTime": sim_time_s, "ActiveFaults": 0, "Health": 0, "FaultCmdCounter": 15},
+        )
 
     def sync(self, k: int) -> dict[str, dict[str, float]]:
         """SYNC(k), then collect the answer up to the last THR_CMD frame."""
@@ -87,14 +102,14 @@ def setup() -> Iterator[tuple[FlightNode, Bench]]:
         yield node, bench
     finally:
         node._stop = True
-        bench.send("BENCH_STATUS", {"SimTime": 0.0, "ActiveFaults": 0, "Health": 0})
+        bench.bench_status(0.0)
         t.join(RECV_TIMEOUT_S)
         fsw_bus.shutdown()
         bench_bus.shutdown()
 
 
 def test_each_sync_is_answered_for_its_cycle(setup: tuple[FlightNode, Bench]) -> None:
-    """THR_CMD carries the SYNC's cycle number and on-times within the period."""
+    """THR_CMD carries the SYNC's cycle number and on-times within the period (or full on)."""
     node, bench = setup
     for k in range(5):
         bench.sensors()
@@ -106,7 +121,8 @@ def test_each_sync_is_answered_for_its_cycle(setup: tuple[FlightNode, Bench]) ->
             for n, v in got[f].items()
             if n.startswith("OnTime")
         ]
-        assert all(0.0 <= x <= PERIOD_S for x in on)
+        # within the period, or a full-on pulse stretched to overlap the next command
+        assert all(0.0 <= x <= PERIOD_S or x == pytest.approx(FULL_ON_S) for x in on)
     assert node.fc.mode == Mode.NOMINAL
 
 
@@ -143,3 +159,62 @@ def test_imu_silence_latches_safe_mode_with_valves_closed(setup: tuple[FlightNod
     assert node.fc.mode == Mode.SAFE
     status = node.fc.cycle(11 * 20_000_000)
     assert status.fdir_flags & FdirFlag.SAFE_LATCHED
+
+
+def test_fsw_fdir_is_sent_with_each_status(setup: tuple[FlightNode, Bench]) -> None:
+    """Status cycles carry FSW_FDIR: all 8 thrusters available, no failure, no sensor flag."""
+    _, bench = setup
+    bench.sensors()
+    got = bench.sync(0)
+    fdir = got["FSW_FDIR"]
+    assert fdir["AvailableMask"] == 0xFF and fdir["FailedThruster"] == 31
+    assert fdir["FailureKind"] == 0 and fdir["SensorFlags"] == 0
+
+
+def test_sync_back_to_zero_is_a_bench_restart(setup: tuple[FlightNode, Bench]) -> None:
+    """SYNC(0) after SYNC(6): answered, the computer starts again, SensorFlags bit 3 set."""
+    node, bench = setup
+    for k in range(7):
+        bench.sensors()
+        bench.sync(k)
+    assert node.fc.mode == Mode.NOMINAL
+    bench.sensors()
+    got = bench.sync(0)
+    assert got["THR_CMD_0"]["Cycle"] == 0
+    assert node.fc.restarts == 1 and node.stats.restarts == 1
+    assert got["FSW_FDIR"]["SensorFlags"] & SensorFlag.BENCH_RESTART
+    assert got["FSW_STATUS"]["FdirFlags"] & FdirFlag.BENCH_RESTART
+    for k in range(1, 6):
+        bench.sensors()
+        got = bench.sync(k)
+        assert got["THR_CMD_0"]["Cycle"] == k
+    assert node.fc.mode == Mode.NOMINAL
+    assert node.checker.summary()["SYNC"]["rejected"] == {}
+
+
+def test_bench_time_going_backwards_is_a_restart(setup: tuple[FlightNode, Bench]) -> None:
+    """BENCH_STATUS SimTime 0.1 s then 0.0 s: restart; the next SYNC(0) is answered."""
+    node, bench = setup
+    for k in range(6):
+        bench.sensors()
+        if k == 5:
+            bench.bench_status(0.1)
+        bench.sync(k)
+    bench.bench_status(0.0)
+    bench.sensors()
+    got = bench.sync(0)
+    assert got["THR_CMD_0"]["Cycle"] == 0
+    assert node.fc.restarts == 1
+
+
+def test_heartbeat_resumes_when_the_bench_goes_quiet(setup: tuple[FlightNode, Bench]) -> None:
+    """After a second without frames the node sends FSW_STATUS alone, with its current mode."""
+    _, bench = setup
+    for k in range(3):
+        bench.sensors()
+        bench.sync(k)
+    msg = bench.bus.recv(HEARTBEAT_WAIT_S)
+    assert msg is not None
+    d = bench.chk.check(msg)
+    assert d is not None and d.name == "FSW_STATUS"
+    assert d.signals["Mode"] == Mode.NOMINAL

@@ -1,0 +1,98 @@
+"""Expected-thrust model of the FDIR: pulse impulse, merging of consecutive pulses, samples."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from flight_sw.fdir.thrust_model import ThrustModel
+
+N = 4
+NS = 1_000_000_000
+MIN_ON_S = 0.005
+DELAY_S, OD_S, CD_S, TR_S, TT_S = 0.0015, 0.003, 0.002, 0.002, 0.003
+HORIZON_NS = 2 * NS
+IMPULSE_TOL_S = 1e-9
+PERIOD_NS = 20_000_000
+
+
+def model() -> ThrustModel:
+    """A 4-thruster model with the fdir_16thr valve data."""
+    return ThrustModel(N, MIN_ON_S, DELAY_S, OD_S, CD_S, TR_S, TT_S, HORIZON_NS)
+
+
+def pulse_thrust_time_s(on_s: float) -> float:
+    """Closed form of one isolated pulse from rest (the valve model's), over T_max [s]."""
+    d = max(0.0, max(on_s, MIN_ON_S) + CD_S - OD_S)
+    peak = 1.0 - math.exp(-d / TR_S)
+    return d - TR_S * peak + peak * TT_S
+
+
+@pytest.mark.parametrize("on_s", [0.001, 0.005, 0.012, 0.02])
+def test_single_pulse_thrust_time_matches_the_closed_form(on_s: float) -> None:
+    """∫F/T_max of a pulse equals the valve's closed-form impulse (short pulses extended)."""
+    m = model()
+    on = np.zeros(N)
+    on[1] = on_s
+    m.command(0, on)
+    tau = m.thrust_time_s(0, NS)
+    assert tau[1] == pytest.approx(pulse_thrust_time_s(on_s), abs=IMPULSE_TOL_S)
+    assert tau[[0, 2, 3]] == pytest.approx(0.0)
+
+
+def test_window_splits_the_impulse() -> None:
+    """Thrust-time over [0, t] + [t, ∞) is the whole pulse's."""
+    m = model()
+    on = np.full(N, 0.01)
+    m.command(0, on)
+    t_mid = 8_000_000
+    whole = m.thrust_time_s(0, NS)
+    assert m.thrust_time_s(0, t_mid) + m.thrust_time_s(t_mid, NS) == pytest.approx(whole)
+
+
+def test_consecutive_full_pulses_merge_into_continuous_thrust() -> None:
+    """Full-period pulses every period: no new opening, thrust ≈ T_max after the rise."""
+    m = model()
+    on = np.full(N, PERIOD_NS / NS)
+    for k in range(10):
+        m.command(k * PERIOD_NS, on)
+    t = np.arange(50_000_000, 180_000_000, 5_000_000)
+    frac, _ = m.fraction_at(t)
+    assert frac == pytest.approx(1.0, abs=1e-6)
+
+
+def test_zero_command_switches_a_pulse_off() -> None:
+    """A 0 arriving during a long pulse cuts it: thrust decays from then on."""
+    m = model()
+    on = np.zeros(N)
+    on[0] = 0.1  # 100 ms requested
+    m.command(0, on)
+    m.command(PERIOD_NS, np.zeros(N))
+    t_cut = PERIOD_NS + round(DELAY_S * NS) + round(CD_S * NS)
+    frac, _ = m.fraction_at(np.array([t_cut + 30_000_000]))
+    assert frac[0, 0] < 1e-3
+
+
+def test_sampled_fraction_follows_rise_and_tail() -> None:
+    """Samples: 0 before opening, 1 − e^{−t/τr} while driven, exponential tail after."""
+    m = model()
+    on = np.zeros(N)
+    on[2] = 0.01
+    m.command(0, on)
+    t_open = round((DELAY_S + OD_S) * NS)
+    t_close = round((DELAY_S + 0.01 + CD_S) * NS)
+    samples = np.array([t_open - 1, t_open + 2_000_000, t_close + 3_000_000])
+    frac, rate = m.fraction_at(samples)
+    peak = 1.0 - math.exp(-(t_close - t_open) / NS / TR_S)
+    assert frac[:, 2] == pytest.approx([0.0, 1.0 - math.exp(-1.0), peak * math.exp(-1.0)], rel=1e-9)
+    assert rate[1, 2] == pytest.approx(math.exp(-1.0) / TR_S, rel=1e-9)
+
+
+def test_stuck_open_is_full_thrust() -> None:
+    """A thruster known stuck open: thrust-time = window, fraction 1."""
+    m = model()
+    m.stuck_open[3] = True
+    assert m.thrust_time_s(0, 300_000_000)[3] == pytest.approx(0.3)
+    assert m.fraction_at(np.array([1, 2]))[0][:, 3] == pytest.approx(1.0)
