@@ -211,6 +211,7 @@ class BenchNode:
         self.tel_t: list[float] = []
         self.tel_err: list[float] = []
         self.tel_rate_err: list[float] = []
+        self.tel_pos_err: list[float] = []  # position hold: distance from the initial position
         self.wall_s = 0.0
         self.fsw_alive: Callable[[], bool] | None = None
         self._wire_pending: dict[int, tuple[can.Message, bool, int]] = {}
@@ -265,6 +266,7 @@ class BenchNode:
             self.tel_t.append(t_ns / NS_PER_S)
             self.tel_err.append(err)
             self.tel_rate_err.append(rate_err)
+            self.tel_pos_err.append(math.dist(s[7:10], self.sc.r0_N_m))
 
     # -- sensors -----------------------------------------------------------------
     def _sample(self, name: str, t_ns: int) -> dict[str, float | int]:
@@ -804,6 +806,9 @@ class BenchNode:
         other: dict[str, dict[str, int]] = {}
         merge_counts(frames, other, BENCH_NODE, self.sent, self.checker.summary())
         e = sc.expectations
+        pos, t_arr = np.asarray(self.tel_pos_err), np.asarray(self.tel_t)
+        pos_final = float(pos[-1]) if len(pos) else 0.0
+        pos_ss = float(pos[t_arr >= t_arr[-1] - e.steady_state_window_s].max()) if len(pos) else 0.0
         exps = [
             x
             for x in (
@@ -818,6 +823,9 @@ class BenchNode:
                     pm.steady_state_rate_error_deg_s,
                     e.steady_state_rate_error_deg_s_max,
                 ),
+                expectation("steady_state_position_error_m", pos_ss,
+                            e.steady_state_position_error_m_max),
+                expectation("final_position_error_m", pos_final, e.final_position_error_m_max),
             )
             if x is not None
         ]
@@ -839,7 +847,8 @@ class BenchNode:
             "steady_state_attitude_error_deg": pm.steady_state_attitude_error_deg,
             "steady_state_rate_error_deg_s": pm.steady_state_rate_error_deg_s,
             "final_attitude_error_deg": pm.final_attitude_error_deg,
-            "final_position_error_m": math.dist(self.plant.state[7:10], sc.r0_N_m),
+            "final_position_error_m": pos_final,
+            "steady_state_position_error_m": pos_ss,
             "propellant_kg": thr.total_propellant_kg,
             "valve_openings": {"total": int(sum(thr.openings)), "per_thruster": list(thr.openings)},
             "frames": frames,

@@ -108,6 +108,8 @@ class Expectations:
     steady_state_attitude_error_deg_max: float | None
     steady_state_rate_error_deg_s_max: float | None
     steady_state_window_s: float
+    steady_state_position_error_m_max: float | None = None
+    final_position_error_m_max: float | None = None
 
 
 @dataclass(frozen=True)
@@ -341,6 +343,8 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         settling_time_s_max=_opt(et, "settling_time_s_max"),
         steady_state_attitude_error_deg_max=_opt(et, "steady_state_attitude_error_deg_max"),
         steady_state_rate_error_deg_s_max=_opt(et, "steady_state_rate_error_deg_s_max"),
+        steady_state_position_error_m_max=_opt(et, "steady_state_position_error_m_max"),
+        final_position_error_m_max=_opt(et, "final_position_error_m_max"),
         steady_state_window_s=et.number(
             "steady_state_window_s", 10.0, lo=0.0, lo_open=True, hi=duration_s
         ),
