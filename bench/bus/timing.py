@@ -185,41 +185,77 @@ _CRC15_TABLE = _crc15_table()
 _RUNS = re.compile(r"0+|1+")
 
 
+# Bit-stuffing as a state machine over whole bytes: state = 5 * last_bit + run (run =
+# equal bits so far, 0..4), plus START; STUFF_TABLES[k][state][value] = (state', stuffs)
+# for the k-bit chunk ``value`` sent MSB first.
+STUFF_START = 2 * STUFF_RUN
+
+
+def _stuff_step(state: int, bit: int) -> tuple[int, int]:
+    last, run = divmod(state, STUFF_RUN) if state != STUFF_START else (-1, 0)
+    if bit == last:
+        run += 1
+        if run == STUFF_RUN:  # stuff bit (the complement) starts a new run of one
+            return STUFF_RUN * (1 - bit) + 1, 1
+        return STUFF_RUN * bit + run, 0
+    return STUFF_RUN * bit + 1, 0
+
+
+def _stuff_tables(width: int) -> tuple[tuple[tuple[int, int], ...], ...]:
+    tables = []
+    for state in range(STUFF_START + 1):
+        row = []
+        for value in range(1 << width):
+            st, n = state, 0
+            for i in range(width - 1, -1, -1):
+                st, k = _stuff_step(st, (value >> i) & 1)
+                n += k
+            row.append((st, n))
+        tables.append(tuple(row))
+    return tuple(tables)
+
+
+_STUFF8 = _stuff_tables(8)
+_STUFF7 = _stuff_tables(7)
+
+
 @functools.lru_cache(maxsize=4096)
-def _header(can_id: int, dlc: int, extended: bool, remote: bool) -> tuple[str, int]:
-    """Bits SOF..DLC of a frame and the CRC-15 register after them."""
+def _header(can_id: int, dlc: int, extended: bool, remote: bool) -> tuple[int, int, int, int]:
+    """(bits, CRC-15 register, stuffing state, stuff bits) after SOF..DLC of a frame."""
     rtr = 1 if remote else 0
     if extended:
         head = f"0{can_id >> 18:011b}11{can_id & 0x3FFFF:018b}{rtr}00{dlc:04b}"
     else:
         head = f"0{can_id:011b}{rtr}00{dlc:04b}"
-    return head, crc15([int(c) for c in head])
+    state, stuff = STUFF_START, 0
+    for c in head:
+        state, k = _stuff_step(state, int(c))
+        stuff += k
+    return len(head), crc15([int(c) for c in head]), state, stuff
 
 
 def frame_bits(can_id: int, data: bytes, extended: bool = False, remote: bool = False) -> int:
     """Exact length of a classic CAN frame on the wire in bits, including intermission.
 
     Same result as ``len(frame_bitstream) + stuff_count(...) + tail`` (tested against an
-    independent stuffer), computed fast because the bench calls it per frame: the header
-    and its CRC state are cached, data bytes go through a byte-wise CRC-15 table, and
-    stuffing is counted per run of equal bits: a run of effective length E (its length,
-    plus one if the previous run ended on a stuff bit, which has this run's value) gets
-    E // 5 stuff bits and passes one on when E is a multiple of 5.
+    independent stuffer on 10 000 random frames), computed fast because the bench calls it
+    per frame: the header's CRC and stuffing state are cached, and data bytes go through a
+    byte-wise CRC-15 table and a byte-wise stuffing state machine.
     """
     dlc = len(data)
-    head, crc = _header(can_id, dlc, extended, remote)
-    if remote or not dlc:
-        bits = head + f"{crc:015b}"
-    else:
+    n_bits, crc, state, stuff = _header(can_id, dlc, extended, remote)
+    if not remote:
+        t8 = _STUFF8
         for byte in data:
             crc = ((crc << 8) & 0x7FFF) ^ _CRC15_TABLE[((crc >> 7) ^ byte) & 0xFF]
-        bits = head + f"{int.from_bytes(data, 'big'):0{8 * dlc}b}" + f"{crc:015b}"
-    stuff = carry = 0
-    for run in _RUNS.findall(bits):
-        e = len(run) + carry
-        stuff += e // STUFF_RUN
-        carry = 1 if e % STUFF_RUN == 0 else 0
-    return len(bits) + stuff + UNSTUFFED_TAIL_BITS
+            state, k = t8[state][byte]
+            stuff += k
+        n_bits += 8 * dlc
+    state, k = _STUFF8[state][crc >> 7]  # CRC-15: its top 8 bits, then the low 7
+    stuff += k
+    state, k = _STUFF7[state][crc & 0x7F]
+    stuff += k
+    return n_bits + CRC15_BITS + stuff + UNSTUFFED_TAIL_BITS
 
 
 def _worst_case_stuffed(unstuffed_bits: int) -> int:
