@@ -63,3 +63,15 @@ class TranslationController(Protocol):
     ) -> np.ndarray:
         """The demanded force in body axes [N], shape (3,)."""
         ...
+
+
+def error_limit(kp: np.ndarray, kd: np.ndarray, max_rate: float) -> np.ndarray:
+    """Per-axis clip of the proportional error so a saturated PD law settles at ``max_rate``.
+
+    Far from the target the law ``−K_p sat_L(e) − K_d ė`` drives ``ė`` towards
+    ``K_p L / K_d``; ``L = K_d max_rate / K_p`` makes that the rate limit (Wie & Lu 1995).
+    Axes with ``K_p = 0`` or no limit (``max_rate = inf``) get ``inf``.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lim = kd * max_rate / kp
+    return np.where(np.isfinite(lim), lim, np.inf)

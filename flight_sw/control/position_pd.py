@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
+from flight_sw.control.base import error_limit
 from flight_sw.quaternion import to_dcm
 
 N_AXES = 3
@@ -125,9 +126,7 @@ class PositionPd:
         self._params = params
         self._kp = np.array(params.kp_N_m, dtype=float)
         self._kd = np.array(params.kd_N_s_m, dtype=float)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lim = self._kd * params.max_speed_m_s / self._kp
-        self._r_limit = np.where(np.isfinite(lim), lim, np.inf)
+        self._r_limit = error_limit(self._kp, self._kd, params.max_speed_m_s)
         self._f_max = params.max_force_N
 
     @property

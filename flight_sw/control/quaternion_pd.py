@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
+from flight_sw.control.base import error_limit
 from flight_sw.quaternion import error_quaternion
 
 N_AXES = 3
@@ -139,9 +140,7 @@ class QuaternionPd:
         self._kp = np.array(params.kp_Nm, dtype=float)
         self._kd = np.array(params.kd_Nms, dtype=float)
         # slew-rate limit: |δq_i| is clipped at L_i = K_d,i ω_max / K_p,i (Wie & Lu 1995)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lim = self._kd * params.max_rate_rad_s / self._kp
-        self._q_limit = np.where(np.isfinite(lim), lim, np.inf)
+        self._q_limit = error_limit(self._kp, self._kd, params.max_rate_rad_s)
 
     @property
     def params(self) -> QuaternionPdParams:
