@@ -674,16 +674,22 @@ class BenchNode:
             self.fault_counts["delayed"] += bool(fate.delay_ns)
             for _copy in range(2 if fate.duplicate else 1):
                 bits = frame_bits(msg.arbitration_id, bytes(msg.data))
-                if name is not None and self.sender_of[name] != BENCH_NODE:
-                    # a frame of the flight software's cycle: on the modelled wire
+                d = self.checker.check(msg)
+                # A frame of the flight software's cycle goes on the modelled wire: one that
+                # passes the checks, or one an injected bus fault spoiled. Anything else
+                # (unknown IDs, error frames, malformed impostors of known IDs) arrives at
+                # a wall-clock moment that has no place in simulated time: trace only, so
+                # garbage on the bus cannot shift a lockstep run (tests/e2e/test_flood.py).
+                faulted = fate.corrupt_bit is not None or fate.duplicate
+                if (name is not None and self.sender_of[name] != BENCH_NODE
+                        and (d is not None or faulted)):
                     seq = self.arbiter.submit(ready_ns, msg.arbitration_id, bits,
                                               node=self.sender_of[name],
                                               failed_attempts=fate.failed_attempts)
                     self._wire_pending[seq] = (msg, False, bits)
-                else:  # foreign traffic (unknown IDs, error frames, impostors): trace only
+                else:
                     seq = -1
                     self.trace.frame(msg, ready_ns, tx=False, t_rx_ns=NAN, bits=bits)
-                d = self.checker.check(msg)
                 if d is None:
                     if name is not None and name.startswith("THR_CMD_") and _copy == 0:
                         lost += 1  # rejected (e.g. corrupted): this cycle will not get it
