@@ -10,7 +10,9 @@ it]; ``q_BN`` the (estimated) attitude, scalar-first, maps inertial N to body B;
 ``omega_BN_B`` the (estimated) body rate of B relative to N in body axes [rad/s];
 ``q_RN`` the reference attitude (maps N to the reference frame R); ``omega_RN_B`` the
 reference rate of R relative to N expressed in body axes [rad/s] (zero for regulation or
-a slew to a fixed attitude).
+a slew to a fixed attitude); ``domega_RN_B`` the reference angular acceleration (derivative
+taken in R, expressed in body axes) [rad/s²], None for a fixed reference (laws without
+feed-forward ignore it).
 Output: the demanded control torque about the centre of mass in body axes [N m], shape (3,).
 
 Assumptions: unit quaternions; the caller expresses the reference rate in body axes
@@ -36,8 +38,51 @@ class AttitudeController(Protocol):
         omega_BN_B: np.ndarray,
         q_RN: np.ndarray,
         omega_RN_B: np.ndarray,
+        domega_RN_B: np.ndarray | None = None,
     ) -> np.ndarray:
         """The demanded torque in body axes [N m], shape (3,)."""
+        ...
+
+
+class InertiaAware(Protocol):
+    """A law built on a model of the mass properties that an identifier can update.
+
+    The flight computer calls :meth:`set_inertia_B_kgm2` when an inertia estimator (e.g.
+    :mod:`flight_sw.estimation.rls_inertia`) has a new estimate; laws that do not use the
+    inertia simply do not implement it.
+    """
+
+    def set_inertia_B_kgm2(self, inertia_B_kgm2: np.ndarray) -> None:
+        """Use ``inertia_B_kgm2`` (3×3, body axes, about the centre of mass) from now on."""
+        ...
+
+
+class PoseController(Protocol):
+    """A coupled 6-DoF law producing force and torque together (e.g. dual-quaternion laws).
+
+    Inputs: ``t_ns`` [integer ns]; ``q_BN``/``omega_BN_B`` the estimated attitude and body
+    rate [rad/s]; ``r_N_m``/``v_N_m_s`` position [m] and velocity [m/s] in the navigation
+    frame N (inertial, or the Hill frame of a relative-navigation sensor); ``q_RN``,
+    ``omega_RN_B`` the reference attitude and rate (body axes); ``r_ref_N_m``,
+    ``v_ref_N_m_s`` the reference position and velocity in N.
+    Output: shape (6,): the demanded force on the vehicle in body axes [N] (first three)
+    and torque about the centre of mass in body axes [N m] (last three), the row order of
+    the 6-row effectiveness matrix.
+    """
+
+    def wrench_B(
+        self,
+        t_ns: int,
+        q_BN: np.ndarray,
+        omega_BN_B: np.ndarray,
+        r_N_m: np.ndarray,
+        v_N_m_s: np.ndarray,
+        q_RN: np.ndarray,
+        omega_RN_B: np.ndarray,
+        r_ref_N_m: np.ndarray,
+        v_ref_N_m_s: np.ndarray,
+    ) -> np.ndarray:
+        """The demanded wrench [force_B_N; torque_B_Nm], shape (6,)."""
         ...
 
 

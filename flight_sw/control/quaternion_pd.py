@@ -154,6 +154,7 @@ class QuaternionPd:
         omega_BN_B: np.ndarray,
         q_RN: np.ndarray,
         omega_RN_B: np.ndarray,
+        domega_RN_B: np.ndarray | None = None,
     ) -> np.ndarray:
         """``τ_B = −K_p ∘ sat_L(sgn(δq0) δq_vec) − K_d ∘ (ω_BN_B − ω_RN_B)`` [N m]."""
         dq = error_quaternion(q_RN, q_BN)

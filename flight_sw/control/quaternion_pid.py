@@ -103,6 +103,7 @@ class QuaternionPid:
         omega_BN_B: np.ndarray,
         q_RN: np.ndarray,
         omega_RN_B: np.ndarray,
+        domega_RN_B: np.ndarray | None = None,
     ) -> np.ndarray:
         """``τ_PD − K_p ∘ x_I`` [N m] (see the module docstring)."""
         p = self._params
