@@ -37,19 +37,27 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from flight_sw.allocation.base import Allocator
-from flight_sw.control.base import AttitudeController, TranslationController
-from flight_sw.estimation.base import AttitudeEstimator
+from flight_sw.control.base import (
+    AttitudeController,
+    PoseController,
+    TranslationController,
+)
+from flight_sw.estimation.base import AttitudeEstimator, InertiaIdentifier
 from flight_sw.fdir.base import ThrusterFailure
 from flight_sw.fdir.frozen_sensor import FrozenSensorMonitor
 from flight_sw.fdir.sensor_watchdog import SensorWatchdog
 from flight_sw.fdir.thruster_fdir import FdirReport, ThrusterFdir
 from flight_sw.modes import FdirFlag, Mode, SensorFlag
 from flight_sw.modulation.base import Modulator
+from flight_sw.quaternion import to_dcm
+
+if TYPE_CHECKING:
+    from flight_sw.guidance.base import AttitudeGuidance
 
 NS_PER_S = 1_000_000_000
 TORQUE_DIM = 3
@@ -67,12 +75,13 @@ class CycleResult:
     mode: Mode
     fdir_flags: int
     saturated: bool
-    residual_Nm: float
+    residual_Nm: float  # torque part of the allocation residual ‖demand − B T‖ [N m]
     imu_counter: int
     torque_cmd_B_Nm: tuple[float, float, float]
     force_cmd_B_N: tuple[float, float, float] = ZERO3
     sensor_flags: int = 0
     fdir: FdirReport | None = None
+    residual_force_N: float = 0.0  # force part (6-DoF allocation) [N]
 
 
 @dataclass
@@ -98,7 +107,7 @@ class FlightComputer:
     controller: AttitudeController
     allocator: Allocator
     modulators: list[Modulator]
-    max_thrust_N: float
+    max_thrust_N: np.ndarray  # per thruster [N], shape (n,)
     control_period_ns: int
     imu_period_ns: int
     timeline: Timeline
@@ -111,6 +120,9 @@ class FlightComputer:
     make_modulator: Callable[[], Modulator] | None = None
     allocators_by_mask: dict[tuple[bool, ...], Allocator] = field(default_factory=dict)
     nav_timeout_ns: int = DEFAULT_NAV_TIMEOUT_NS
+    guidance: AttitudeGuidance | None = None  # a moving reference (else the Timeline's step)
+    pose: PoseController | None = None  # a coupled 6-DoF law (replaces both controllers)
+    inertia_id: InertiaIdentifier | None = None
     mode: Mode = Mode.BOOT
     safe_latched: bool = False
     imu_counter: int = 0
@@ -123,9 +135,14 @@ class FlightComputer:
     _nav_r: tuple[int, np.ndarray] | None = None
     _nav_v: tuple[int, np.ndarray] | None = None
     _allocator_full: Allocator | None = None
+    _torque_applied_B_Nm: np.ndarray | None = None  # last cycle's allocated torque
+    inertia_B_kgm2: np.ndarray | None = None  # latest identified inertia (telemetry)
 
     def __post_init__(self) -> None:
         self._allocator_full = self.allocator
+        self.max_thrust_N = np.broadcast_to(
+            np.asarray(self.max_thrust_N, dtype=float), (len(self.modulators),)
+        ).copy()
 
     # --- sensor input -------------------------------------------------------------------
 
@@ -200,7 +217,7 @@ class FlightComputer:
         """The bench restarted (its time went back to ``bench_time_ns`` at our ``t_ns``)."""
         if self.make_estimator is not None:
             self.estimator = self.make_estimator()
-        for stateful in (self.controller, self.translation):
+        for stateful in (self.controller, self.translation, self.pose):
             reset = getattr(stateful, "reset", None)
             if callable(reset):
                 reset()  # e.g. an integral term
@@ -261,6 +278,44 @@ class FlightComputer:
             return None
         return r, v
 
+    def _attitude_reference(
+        self, t_ns: int, q_BN: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Reference attitude, rate and acceleration (the last two in body axes)."""
+        tl = self.timeline
+        if self.guidance is not None:
+            ref = self.guidance.reference(t_ns - tl.time_base_ns)
+            q_RN = np.asarray(ref.q_RN, dtype=float)
+            # body axes: C_BR = C_BN C_NR (feed-forward of the reference motion)
+            c_BR = to_dcm(q_BN) @ to_dcm(q_RN).T
+            return q_RN, c_BR @ ref.omega_RN_R, c_BR @ ref.domega_RN_R
+        if t_ns - tl.time_base_ns >= tl.t_start_ns:
+            return tl.q_target_BN, np.zeros(3), None
+        if self._q_hold_BN is None:
+            self._q_hold_BN = np.array(q_BN, dtype=float)
+        return self._q_hold_BN, np.zeros(3), None
+
+    def _position_reference(self, r_N_m: np.ndarray) -> np.ndarray:
+        """The position to hold: the configured target, else the first navigation fix."""
+        if self.timeline.r_target_N_m is not None:
+            return self.timeline.r_target_N_m
+        if self._r_hold_N_m is None:
+            self._r_hold_N_m = r_N_m.copy()
+        return self._r_hold_N_m
+
+    def _identify_inertia(self, t_ns: int, omega_BN_B: np.ndarray) -> None:
+        """Feed the inertia identifier; hand a new estimate to the laws that use one."""
+        if self.inertia_id is None or self._torque_applied_B_Nm is None:
+            return
+        j = self.inertia_id.update(t_ns, omega_BN_B, self._torque_applied_B_Nm)
+        if j is None:
+            return
+        self.inertia_B_kgm2 = j
+        for law in (self.controller, self.pose):
+            setter = getattr(law, "set_inertia_B_kgm2", None)
+            if callable(setter):  # an InertiaAware law
+                setter(j)
+
     def cycle(self, t_ns: int) -> CycleResult:
         """Run one control cycle at ``t_ns``; returns the valve on-times for the next period."""
         n = len(self.modulators)
@@ -276,8 +331,9 @@ class FlightComputer:
             flags |= FdirFlag.SENSOR_FROZEN
         if self.restarts:
             flags |= FdirFlag.BENCH_RESTART
-        nav = self._nav(t_ns) if self.translation is not None else None
-        if self.translation is not None and nav is None:
+        six_dof = self.translation is not None or self.pose is not None
+        nav = self._nav(t_ns) if six_dof else None
+        if six_dof and nav is None:
             flags |= FdirFlag.NAV_LOST
         fdir = self.thruster_fdir
         report = None
@@ -313,43 +369,49 @@ class FlightComputer:
                 report,
             )
         self.mode = Mode.NOMINAL
-        tl = self.timeline
-        if t_ns - tl.time_base_ns >= tl.t_start_ns:
-            q_ref = tl.q_target_BN
-        else:
-            if self._q_hold_BN is None:
-                self._q_hold_BN = np.array(est.q_BN, dtype=float)
-            q_ref = self._q_hold_BN
-        torque = self.controller.torque_B_Nm(t_ns, est.q_BN, est.omega_BN_B, q_ref, np.zeros(3))
+        self._identify_inertia(t_ns, est.omega_BN_B)
+        q_ref, w_ref_B, dw_ref_B = self._attitude_reference(t_ns, est.q_BN)
         force = np.zeros(3)
-        if self.translation is not None:
-            if nav is not None:
-                r, v = nav
-                if tl.r_target_N_m is not None:
-                    r_ref = tl.r_target_N_m
-                else:
-                    if self._r_hold_N_m is None:
-                        self._r_hold_N_m = r.copy()
-                    r_ref = self._r_hold_N_m
-                force = self.translation.force_B_N(t_ns, est.q_BN, r, v, r_ref, np.zeros(3))
+        r, v, r_ref = np.zeros(3), np.zeros(3), np.zeros(3)
+        if nav is not None:
+            r, v = nav
+            r_ref = self._position_reference(r)
+        if self.pose is not None:
+            # without fresh navigation: attitude only, translation coasts
+            wrench = self.pose.wrench_B(
+                t_ns, est.q_BN, est.omega_BN_B, r, v, q_ref, w_ref_B, r_ref, np.zeros(3)
+            )
+            force = wrench[:3] if nav is not None else np.zeros(3)
+            torque = wrench[3:]
             demand = np.concatenate((force, torque))
         else:
-            demand = torque
+            torque = self.controller.torque_B_Nm(
+                t_ns, est.q_BN, est.omega_BN_B, q_ref, w_ref_B, dw_ref_B
+            )
+            if self.translation is not None:
+                if nav is not None:
+                    force = self.translation.force_B_N(t_ns, est.q_BN, r, v, r_ref, np.zeros(3))
+                demand = np.concatenate((force, torque))
+            else:
+                demand = torque
         if fdir is not None and self.effectiveness is not None:
             for j in fdir.stuck_open:  # feed-forward: the others counter its known wrench
-                demand = demand - self.effectiveness[:, j] * self.max_thrust_N
+                demand = demand - self.effectiveness[:, j] * self.max_thrust_N[j]
         alloc = self.allocator.allocate(demand)
+        self._torque_applied_B_Nm = np.asarray(alloc.achieved, dtype=float)[-TORQUE_DIM:]
         period_s = self.control_period_ns / NS_PER_S
         mask = fdir.mask if fdir is not None else None
         on_times = tuple(
             0.0
             if mask is not None and not mask[k]
-            else mod.on_time_s(t_ns, float(thrust) / self.max_thrust_N, period_s)
+            else mod.on_time_s(t_ns, float(thrust) / self.max_thrust_N[k], period_s)
             for k, (mod, thrust) in enumerate(zip(self.modulators, alloc.thrust_N, strict=True))
         )
         if fdir is not None:
             fdir.on_command(t_ns, np.array(on_times))
-        r_torque = (demand - alloc.achieved)[-TORQUE_DIM:]
+        r_demand = demand - alloc.achieved
+        r_torque = r_demand[-TORQUE_DIM:]
+        r_force = float(np.linalg.norm(r_demand[:-TORQUE_DIM]))  # empty (0) in attitude-only
         return CycleResult(
             on_times,
             self.mode,
@@ -361,4 +423,5 @@ class FlightComputer:
             (float(force[0]), float(force[1]), float(force[2])),
             sensor_flags,
             report,
+            r_force,
         )

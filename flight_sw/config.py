@@ -72,9 +72,13 @@ class Vehicle:
             raise root.error("thrusters", [], "at least one thruster")
         self.r_thr_B_m = np.array([x.vector("r_thr_B_m", 3) for x in thr])
         self.d_thr_B = np.array([x.vector("d_thr_B", 3) for x in thr])
+        self.max_thrust_N = root.number("max_thrust_N", lo=0.0, lo_open=True)
+        # per thruster (optional; e.g. seed 001's opposing pairs of unequal bounds)
+        self.max_thrust_each_N = np.array(
+            [x.number("max_thrust_N", self.max_thrust_N, lo=0.0, lo_open=True) for x in thr]
+        )
         for x in thr:
             x.done()
-        self.max_thrust_N = root.number("max_thrust_N", lo=0.0, lo_open=True)
         self.min_on_s = root.number("min_on_s", lo=0.0)
         self.effectiveness = effectiveness_matrix(self.r_thr_B_m, self.d_thr_B)
         self.demand_rows = TORQUE_ROWS  # WRENCH_ROWS once a translation controller is set
@@ -358,7 +362,7 @@ def build_computer(
         controller=controller,
         allocator=allocator,
         modulators=[make_modulator() for _ in range(n)],
-        max_thrust_N=vehicle.max_thrust_N,
+        max_thrust_N=vehicle.max_thrust_each_N,
         control_period_ns=control_period_ns,
         imu_period_ns=imu_period_ns,
         timeline=Timeline(q_target, t_start_ns, r_target),

@@ -69,6 +69,15 @@ STALE_SYNC_WINDOW = 2
 DETECTION_TIME_MAX_S = 655.35  # FSW_FDIR.DetectionTime range
 ISOLATION_DELAY_MAX_S = 2.55  # FSW_FDIR.IsolationDelay range
 ALLOC_RESIDUAL_MAX_NM = 12.75  # FSW_STATUS.AllocResidual range
+ALLOC_RESIDUAL_MAX_N = 12.75  # FSW_STATUS.AllocForceResidual range
+
+
+def _spread(values: list[float]) -> dict[str, float | None]:
+    """p50, p99 and max of ``values`` (full precision; the bus carries 0.05 steps)."""
+    if not values:
+        return {"p50": None, "p99": None, "max": None}
+    p50, p99 = np.percentile(np.asarray(values, dtype=float), (50.0, 99.0))
+    return {"p50": float(p50), "p99": float(p99), "max": float(max(values))}
 
 
 def _percentiles_us(samples_ns: list[int]) -> dict[str, float | int | None]:
@@ -98,6 +107,9 @@ class NodeStats:
     restarts: int = 0
     sent: dict[str, int] = field(default_factory=dict)
     cycle_ns: list[int] = field(default_factory=list)  # cycle start -> last frame sent
+    residual_Nm: list[float] = field(default_factory=list)  # allocation torque residual
+    residual_N: list[float] = field(default_factory=list)  # allocation force residual
+    saturated_cycles: int = 0
 
 
 class FlightNode:
@@ -162,20 +174,25 @@ class FlightNode:
         self.bus.send(self.encoder.message(name, signals))
         self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
 
+    def _status_signals(self, cycle: int) -> dict[str, float]:
+        """FSW_STATUS content: mode, counters, FDIR flags, the allocation's saturation/residual."""
+        res = self._last_result
+        return {
+            "Mode": int(self.fc.mode),
+            "Cycle": cycle % STATUS_CYCLE_MODULUS,
+            "Overruns": min(self.stats.overruns, OVERRUN_MAX),
+            "FdirFlags": self._last_flags,
+            "AllocSaturated": int(self._last_sat),
+            "AllocResidual": min(self._last_residual, ALLOC_RESIDUAL_MAX_NM),
+            "AllocForceResidual": min(
+                res.residual_force_N if res is not None else 0.0, ALLOC_RESIDUAL_MAX_N
+            ),
+        }
+
     def send_status(self, cycle: int) -> None:
         """FSW_STATUS, FSW_ATT_EST and FSW_FDIR."""
         fc = self.fc
-        self._send(
-            "FSW_STATUS",
-            {
-                "Mode": int(fc.mode),
-                "Cycle": cycle % STATUS_CYCLE_MODULUS,
-                "Overruns": min(self.stats.overruns, OVERRUN_MAX),
-                "FdirFlags": self._last_flags,
-                "AllocSaturated": int(self._last_sat),
-                "AllocResidual": min(self._last_residual, ALLOC_RESIDUAL_MAX_NM),
-            },
-        )
+        self._send("FSW_STATUS", self._status_signals(cycle))
         est = fc.estimator.estimate()
         q = [float(x) for x in est.q_BN]
         self._send("FSW_ATT_EST", {"Valid": int(est.initialised), **pack_quaternion(q)})
@@ -241,6 +258,9 @@ class FlightNode:
             res.residual_Nm,
         )
         self.stats.cycles += 1
+        self.stats.residual_Nm.append(res.residual_Nm)
+        self.stats.residual_N.append(res.residual_force_N)
+        self.stats.saturated_cycles += bool(res.saturated)
         if cycle % self.status_every == 0:
             self.send_status(cycle)
         self.send_commands(cycle, res)
@@ -306,17 +326,7 @@ class FlightNode:
         Sent at start-up and after every second without any frame (before the first SYNC,
         or when the bench has gone: a restarted bench waits for this frame to start).
         """
-        self._send(
-            "FSW_STATUS",
-            {
-                "Mode": int(self.fc.mode),
-                "Cycle": self.stats.cycles % STATUS_CYCLE_MODULUS,
-                "Overruns": min(self.stats.overruns, OVERRUN_MAX),
-                "FdirFlags": self._last_flags,
-                "AllocSaturated": int(self._last_sat),
-                "AllocResidual": min(self._last_residual, ALLOC_RESIDUAL_MAX_NM),
-            },
-        )
+        self._send("FSW_STATUS", self._status_signals(self.stats.cycles))
 
     # -- loops -------------------------------------------------------------------
     def run_lockstep(self) -> None:
@@ -383,6 +393,16 @@ class FlightNode:
                 self.write_stats()
         self.write_stats()
 
+    def _allocation_stats(self) -> dict[str, Any]:
+        """Residual of the allocation (demand − B T) over the run and saturated cycles."""
+        st = self.stats
+        return {
+            "residual_torque_Nm": _spread(st.residual_Nm),
+            "residual_force_N": _spread(st.residual_N),
+            "saturated_cycles": st.saturated_cycles,
+            "cycles": st.cycles,
+        }
+
     def _fdir_stats(self) -> dict[str, Any]:
         """Isolated thruster failures (times relative to the bench's time 0) and flags."""
         fc = self.fc
@@ -419,6 +439,7 @@ class FlightNode:
             "received": self.checker.summary(),
             "mode": self.fc.mode.name,
             "cycle_time_us": _percentiles_us(self.stats.cycle_ns),
+            "allocation": self._allocation_stats(),
             "restarts": self.stats.restarts,
             "fdir": self._fdir_stats(),
         }

@@ -60,3 +60,18 @@ class AttitudeEstimator(Protocol):
     def estimate(self) -> AttitudeEstimate:
         """The current estimate."""
         ...
+
+
+class InertiaIdentifier(Protocol):
+    """Identifies the inertia from body rates and the torque applied (e.g. RLS, seed 001 §2).
+
+    Called once per control cycle with the estimated body rate [rad/s] and the torque
+    [N m] applied over the period that just ended; returns the current 3×3 estimate
+    [kg m²] (body axes, about the centre of mass), or None while not yet excited enough.
+    """
+
+    def update(
+        self, t_ns: int, omega_BN_B: np.ndarray, torque_B_Nm: np.ndarray
+    ) -> np.ndarray | None:
+        """Take one sample; the current inertia estimate or None."""
+        ...
