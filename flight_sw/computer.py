@@ -398,7 +398,6 @@ class FlightComputer:
             for j in fdir.stuck_open:  # feed-forward: the others counter its known wrench
                 demand = demand - self.effectiveness[:, j] * self.max_thrust_N[j]
         alloc = self.allocator.allocate(demand)
-        self._torque_applied_B_Nm = np.asarray(alloc.achieved, dtype=float)[-TORQUE_DIM:]
         period_s = self.control_period_ns / NS_PER_S
         mask = fdir.mask if fdir is not None else None
         on_times = tuple(
@@ -409,6 +408,9 @@ class FlightComputer:
         )
         if fdir is not None:
             fdir.on_command(t_ns, np.array(on_times))
+        if self.effectiveness is not None:  # the torque the valves are told to give
+            mean_thrust_N = np.array(on_times) / period_s * self.max_thrust_N
+            self._torque_applied_B_Nm = self.effectiveness[-TORQUE_DIM:] @ mean_thrust_N
         r_demand = demand - alloc.achieved
         r_torque = r_demand[-TORQUE_DIM:]
         r_force = float(np.linalg.norm(r_demand[:-TORQUE_DIM]))  # empty (0) in attitude-only

@@ -38,19 +38,27 @@ from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
 from flight_sw.computer import DEFAULT_NAV_TIMEOUT_NS, FlightComputer, Timeline
 from flight_sw.control.base import AttitudeController, TranslationController
+from flight_sw.control.cascade_lqr import CascadeLqr, CascadeLqrDesign, CascadeLqrParams
+from flight_sw.control.mrp_direct_parametric import MrpDirectParametric, MrpDirectParametricParams
 from flight_sw.control.position_pd import PositionPd, PositionPdParams
 from flight_sw.control.quaternion_pd import QuaternionPd, QuaternionPdParams
 from flight_sw.control.quaternion_pid import QuaternionPid, QuaternionPidParams
-from flight_sw.estimation.base import AttitudeEstimator
+from flight_sw.estimation.base import AttitudeEstimator, InertiaIdentifier
 from flight_sw.estimation.mekf import Mekf, MekfParams
+from flight_sw.estimation.rls_inertia import RlsInertiaIdentifier, RlsInertiaParams
 from flight_sw.fdir.base import ThrusterFdirStrategy
 from flight_sw.fdir.frozen_sensor import FrozenSensorMonitor, FrozenSensorParams
 from flight_sw.fdir.rate_residual import RateResidualFdir, RateResidualParams
 from flight_sw.fdir.sensor_watchdog import LOST_AFTER_PERIODS, SensorWatchdog
 from flight_sw.fdir.thruster_fdir import ThrusterFdir
 from flight_sw.fdir.valve_status import ValveStatusFdir, ValveStatusParams
+from flight_sw.guidance.base import AttitudeGuidance
+from flight_sw.guidance.mrp_polynomial import SEED001_SIGMA_COEFFS, MrpPolynomialGuidance
 from flight_sw.modulation.base import Modulator
+from flight_sw.modulation.proportional import ProportionalModulator
 from flight_sw.modulation.pwpf import PwpfModulator, PwpfParams
+from flight_sw.modulation.remainder import RemainderModulator, RemainderParams
+from flight_sw.modulation.schmitt import SchmittModulator, SchmittParams
 
 DEG_RAD = math.pi / 180.0
 ARCSEC_RAD = DEG_RAD / 3600.0
@@ -144,6 +152,66 @@ def _quaternion_pid(t: Table, v: Vehicle) -> AttitudeController:
             else math.inf,
         )
     )
+
+
+def _max_rate(t: Table) -> float:
+    """Optional ``max_rate_deg_s`` in rad/s (inf when absent)."""
+    if not t.has("max_rate_deg_s"):
+        return math.inf
+    return t.number("max_rate_deg_s", lo=0.0, lo_open=True) * DEG_RAD
+
+
+def _cascade_lqr(t: Table, v: Vehicle) -> AttitudeController:
+    """Seed 003: Table 1 gains (``table1 = true``), explicit gains, or an LQR design."""
+    max_rate = _max_rate(t)
+    table1 = t.raw("table1", False)
+    if not isinstance(table1, bool):
+        raise t.error("table1", table1, "true or false")
+    if table1:
+        return CascadeLqr(CascadeLqrParams.from_table1(max_rate))
+    if t.has("outer_kp_1_s"):
+        return CascadeLqr(
+            CascadeLqrParams(
+                outer_kp_1_s=t.vector3("outer_kp_1_s"),
+                outer_kd=t.vector3("outer_kd"),
+                inner_kp_Nms=t.vector3("inner_kp_Nms"),
+                max_rate_rad_s=max_rate,
+            )
+        )
+    design = CascadeLqrDesign(
+        inner_kp_Nms=t.vector3("inner_kp_Nms"),
+        q_angle=t.number("q_angle", lo=0.0, lo_open=True),
+        q_rate=t.number("q_rate", 0.0, lo=0.0),
+        r=t.number("r", 1.0, lo=0.0, lo_open=True),
+        max_rate_rad_s=max_rate,
+    )
+    return CascadeLqr.from_design(design, v.inertia_B_kgm2)
+
+
+def _matrix(t: Table, key: str, rows: int, cols: int) -> np.ndarray:
+    value = t.raw(key)
+    try:
+        m = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        m = np.zeros(0)
+    if m.shape != (rows, cols) or not np.all(np.isfinite(m)):
+        raise t.error(key, value, f"a {rows}x{cols} matrix of finite numbers")
+    return m
+
+
+def _mrp_direct_parametric(t: Table, v: Vehicle) -> AttitudeController:
+    """Seed 001 §3: cases 1-3 of §5, or an explicit F0 (6×6) and Z (3×6)."""
+    if t.has("f0"):
+        params = MrpDirectParametricParams(
+            f0=tuple(tuple(float(x) for x in r) for r in _matrix(t, "f0", 6, 6)),
+            z=tuple(tuple(float(x) for x in r) for r in _matrix(t, "z", 3, 6)),
+        )
+    else:
+        case = t.integer("case", 1, lo=1)
+        if case > 3:
+            raise t.error("case", case, "1, 2 or 3 (seed 001 §5)")
+        params = MrpDirectParametricParams.from_case(case)
+    return MrpDirectParametric(params, v.inertia_B_kgm2)
 
 
 def _pseudo_inverse(t: Table, v: Vehicle) -> Allocator:
@@ -244,13 +312,87 @@ def _pwpf(t: Table, v: Vehicle) -> Callable[[], Modulator]:
     return lambda: PwpfModulator(params)
 
 
+def _schmitt(t: Table, v: Vehicle) -> Callable[[], Modulator]:
+    d = SchmittParams()
+    params = SchmittParams(
+        min_on_s=v.min_on_s,
+        level_on=t.number("level_on", d.level_on, lo=0.0, hi=1.0),
+        level_off=t.number("level_off", d.level_off, lo=0.0, hi=1.0),
+    )
+    return lambda: SchmittModulator(params)
+
+
+def _remainder(t: Table, v: Vehicle) -> Callable[[], Modulator]:
+    params = RemainderParams(min_on_s=v.min_on_s)
+    return lambda: RemainderModulator(params)
+
+
+def _proportional(t: Table, v: Vehicle) -> Callable[[], Modulator]:
+    return ProportionalModulator
+
+
+def _rls(t: Table, v: Vehicle) -> InertiaIdentifier:
+    d = RlsInertiaParams(inertia_guess_B_kgm2=v.inertia_B_kgm2)
+    guess = np.array(t.matrix3("inertia_guess_B_kgm2")) if t.has("inertia_guess_B_kgm2") else None
+    return RlsInertiaIdentifier(
+        RlsInertiaParams(
+            inertia_guess_B_kgm2=v.inertia_B_kgm2 if guess is None else guess,
+            forgetting_factor=t.number(
+                "forgetting_factor", d.forgetting_factor, lo=0.0, lo_open=True, hi=1.0
+            ),
+            initial_covariance=t.number(
+                "initial_covariance", d.initial_covariance, lo=0.0, lo_open=True
+            ),
+            min_information=t.number("min_information", d.min_information, lo=0.0),
+            min_regressor_norm=t.number("min_regressor_norm", d.min_regressor_norm, lo=0.0),
+            max_gap_s=t.number("max_gap_s", d.max_gap_s, lo=0.0, lo_open=True),
+        )
+    )
+
+
+def _mrp_polynomial(t: Table, v: Vehicle) -> AttitudeGuidance:
+    coeffs = t.raw("sigma_coeffs", [list(c) for c in SEED001_SIGMA_COEFFS])
+    ok = (
+        isinstance(coeffs, list)
+        and len(coeffs) == 3
+        and all(
+            isinstance(c, list)
+            and c
+            and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in c)
+            for c in coeffs
+        )
+    )
+    if not ok:
+        raise t.error("sigma_coeffs", coeffs, "3 lists of numbers (ascending powers of t)")
+    try:
+        return MrpPolynomialGuidance(
+            sigma_coeffs=tuple(tuple(float(x) for x in c) for c in coeffs),
+            t0_ns=round(t.number("t_start_s", 0.0, lo=0.0) * NS_PER_S),
+            duration_s=t.number("duration_s", 100.0, lo=0.0, lo_open=True),
+        )
+    except ValueError as exc:
+        raise t.error("sigma_coeffs", coeffs, str(exc)) from exc
+
+
 ESTIMATORS: dict[str, Callable[[Table, Vehicle], AttitudeEstimator]] = {"mekf": _mekf}
 CONTROLLERS: dict[str, Callable[[Table, Vehicle], AttitudeController]] = {
     "quaternion_pd": _quaternion_pd,
     "quaternion_pid": _quaternion_pid,
+    "cascade_lqr": _cascade_lqr,
+    "mrp_direct_parametric": _mrp_direct_parametric,
 }
 ALLOCATORS: dict[str, Callable[[Table, Vehicle], Allocator]] = {"pseudo_inverse": _pseudo_inverse}
-MODULATORS: dict[str, Callable[[Table, Vehicle], Callable[[], Modulator]]] = {"pwpf": _pwpf}
+MODULATORS: dict[str, Callable[[Table, Vehicle], Callable[[], Modulator]]] = {
+    "pwpf": _pwpf,
+    "schmitt": _schmitt,
+    "remainder": _remainder,
+    "proportional": _proportional,
+}
+INERTIA_IDENTIFIERS: dict[str, Callable[[Table, Vehicle], InertiaIdentifier]] = {"rls": _rls}
+# Moving references (``[manoeuvre] kind``); "step" is the Timeline (hold, then the target).
+GUIDANCE: dict[str, Callable[[Table, Vehicle], AttitudeGuidance]] = {
+    "mrp_polynomial": _mrp_polynomial
+}
 TRANSLATION_CONTROLLERS: dict[
     str, Callable[[Table, Vehicle], tuple[TranslationController, np.ndarray | None]]
 ] = {"position_pd": _position_pd}
@@ -322,11 +464,18 @@ def build_computer(
     root.raw("source", "")
     vehicle = Vehicle(root.table("vehicle"), root)
     man = root.table("manoeuvre")
-    q_target = np.array(man.vector("q_target_BN", 4))
-    if abs(float(np.linalg.norm(q_target)) - 1.0) > 1e-6:
-        raise man.error("q_target_BN", q_target.tolist(), "a unit quaternion")
-    t_start_ns = round(man.number("t_start_s", lo=0.0) * NS_PER_S)
-    man.done()
+    kind = man.string("kind", "step", choices=("step", *GUIDANCE))
+    guidance: AttitudeGuidance | None = None
+    if kind == "step":
+        q_target = np.array(man.vector("q_target_BN", 4))
+        if abs(float(np.linalg.norm(q_target)) - 1.0) > 1e-6:
+            raise man.error("q_target_BN", q_target.tolist(), "a unit quaternion")
+        t_start_ns = round(man.number("t_start_s", lo=0.0) * NS_PER_S)
+        man.done()
+    else:
+        man.raw("kind")
+        guidance = _build(man, GUIDANCE[kind], vehicle)  # checks every key of the table
+        q_target, t_start_ns = guidance.reference(0).q_RN.copy(), 0
     vehicle.control_period_ns = control_period_ns
     vehicle.imu_period_ns = imu_period_ns
     fsw = root.table("flight_sw", {})
@@ -339,6 +488,11 @@ def build_computer(
         vehicle.demand_rows = WRENCH_ROWS
     allocator = _strategy(fsw, "allocator", ALLOCATORS, vehicle)
     make_modulator = _strategy(fsw, "modulator", MODULATORS, vehicle)
+    inertia_id = (
+        _strategy(fsw, "inertia_identification", INERTIA_IDENTIFIERS, vehicle)
+        if fsw.has("inertia_identification")
+        else None
+    )
     thruster_fdir, precompute = _thruster_fdir(fsw, vehicle)
     if fsw.has("sensor_fdir"):
         monitor = _strategy(fsw, "sensor_fdir", SENSOR_FDIR, vehicle)
@@ -377,6 +531,8 @@ def build_computer(
         make_modulator=make_modulator,
         allocators_by_mask=by_mask,
         nav_timeout_ns=(LOST_AFTER_PERIODS * nav_period if nav_period else DEFAULT_NAV_TIMEOUT_NS),
+        guidance=guidance,
+        inertia_id=inertia_id,
     )
 
 

@@ -1,0 +1,214 @@
+"""The seed papers' simulations, rerun over the bus; figures as JSON, plots for the docs.
+
+Each reproduction is a scenario in ``scenarios/`` run with ``thruster-hil run`` in lockstep
+over a private portable bus (two real processes), in two actuator variants:
+``on_off`` (the scenario as written: on-off valves with delays, rise/tail and minimum
+on-time, driven by PWPF modulators) and ``continuous`` (ideal continuous thrust: the
+bench's throttled valve model, no delays, and the proportional modulator). Prints one JSON
+object with each run's figures (settling, steady-state errors, position convergence,
+propellant, allocation residual and saturation, the scenario's expectations) and, with
+``--plots DIR``, writes comparison plots (PNG) there: docs/reproductions.md shows them.
+
+    python benchmarks/reproductions.py --plots docs/img/reproductions
+    python benchmarks/reproductions.py --only formation_keeping_nftsm
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+SCENARIOS = REPO / "scenarios"
+CONTINUOUS = (
+    "valve.model='throttled'",
+    "flight_sw.modulator={kind='proportional'}",
+)
+SUMMARY_KEYS = (
+    "converged",
+    "settling_time_s",
+    "steady_state_attitude_error_deg",
+    "steady_state_rate_error_deg_s",
+    "final_attitude_error_deg",
+    "position_settling_time_s",
+    "steady_state_position_error_m",
+    "propellant_kg",
+    "valve_openings",
+    "real_time_factor",
+)
+
+
+@dataclass(frozen=True)
+class Reproduction:
+    """One paper simulation: a scenario, and variants as extra ``--set`` overrides."""
+
+    name: str
+    scenario: str
+    paper: str
+    variants: dict[str, tuple[str, ...]] = field(default_factory=dict)
+
+
+def _variants(**extra: tuple[str, ...]) -> dict[str, tuple[str, ...]]:
+    out: dict[str, tuple[str, ...]] = {}
+    for label, sets in extra.items():
+        out[f"{label}/on_off"] = sets
+        out[f"{label}/continuous"] = sets + CONTINUOUS
+    return out
+
+
+REPRODUCTIONS = (
+    Reproduction(
+        "three_axis_tracking_cascade",
+        "three_axis_tracking_cascade.toml",
+        "seed 003, Table 2",
+        _variants(cascade_lqr=()),
+    ),
+    Reproduction(
+        "formation_keeping_nftsm",
+        "formation_keeping_nftsm.toml",
+        "seed 000, Figs. 2-4",
+        _variants(nftsm=(), tsm=("flight_sw.controller.kind='tsm_dq'",)),
+    ),
+    Reproduction(
+        "mrp_trajectory_tracking",
+        "mrp_trajectory_tracking.toml",
+        "seed 001, Figs. 4-6",
+        _variants(
+            case1=("flight_sw.controller.case=1",),
+            case2=("flight_sw.controller.case=2",),
+            case3=("flight_sw.controller.case=3",),
+        ),
+    ),
+    Reproduction(
+        "robust_allocation_tracking",
+        "mrp_trajectory_tracking.toml",
+        "seed 001, Figs. 7-11",
+        _variants(
+            pseudo_inverse=("flight_sw.allocator={kind='pseudo_inverse'}",),
+            robust_polyhedral=("flight_sw.allocator={kind='robust_polyhedral'}",),
+            robust_polytopic=("flight_sw.allocator={kind='robust_polytopic'}",),
+            robust_lft=("flight_sw.allocator={kind='robust_lft'}",),
+        ),
+    ),
+)
+
+
+def run_scenario(scenario: Path, sets: tuple[str, ...], out: Path) -> dict[str, Any]:
+    """``thruster-hil run`` in lockstep on a private portable bus; the run's summary."""
+    xdg = Path(tempfile.mkdtemp(prefix="xdg-"))
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
+    cmd = [sys.executable, "-m", "bench.cli", "run", str(scenario), "--out", str(out),
+           "--bus", f"hilbus:rp{uuid.uuid4().hex[:8]}"]
+    for s in sets:
+        cmd += ["--set", s]
+    done = subprocess.run(cmd, cwd=REPO, env=env, capture_output=True, text=True, check=False)
+    summary_path = out / "summary.json"
+    if not summary_path.exists():
+        return {"error": done.stderr.strip().splitlines()[-1:] or ["no summary"]}
+    summary: dict[str, Any] = json.loads(summary_path.read_text(encoding="utf-8"))
+    return summary
+
+
+def figures(summary: dict[str, Any], run_dir: Path) -> dict[str, Any]:
+    """The figures of one run that the reproduction tables quote."""
+    out = {k: summary.get(k) for k in SUMMARY_KEYS if k in summary}
+    out["expectations_passed"] = summary.get("passed")
+    out["failed_expectations"] = [
+        e for e in summary.get("expectations", []) if isinstance(e, dict) and not e.get("ok")
+    ]
+    stats_path = run_dir / "fsw_stats.json"
+    if stats_path.exists():
+        stats = json.loads(stats_path.read_text(encoding="utf-8"))
+        out["allocation"] = stats.get("allocation")
+        out["fsw_cycle_time_us"] = stats.get("cycle_time_us")
+    if "error" in summary:
+        out["error"] = summary["error"]
+    return out
+
+
+def read_telemetry(run_dir: Path) -> dict[str, np.ndarray]:
+    """Columns of ``telemetry.csv`` as float arrays (non-numeric columns skipped)."""
+    with (run_dir / "telemetry.csv").open(newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    cols: dict[str, np.ndarray] = {}
+    for key in rows[0] if rows else []:
+        try:
+            cols[key] = np.array([float(r[key]) for r in rows])
+        except ValueError:
+            continue
+    return cols
+
+
+def plot_comparison(rep: Reproduction, run_dirs: dict[str, Path], dest: Path) -> list[Path]:
+    """Attitude error (and position error in 6 DoF) of every variant on shared axes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tel = {v: read_telemetry(d) for v, d in run_dirs.items() if (d / "telemetry.csv").exists()}
+    if not tel:
+        return []
+    six_dof = any(np.ptp(t.get("rx_m", np.zeros(1))) > 0 for t in tel.values())
+    fig, axes = plt.subplots(2 if six_dof else 1, 1, figsize=(8, 6 if six_dof else 3.5),
+                             squeeze=False)
+    for variant, t in tel.items():
+        axes[0][0].semilogy(t["t_s"], np.maximum(t["att_err_deg"], 1e-4), label=variant)
+        if six_dof:
+            pos = np.sqrt(t["rx_m"] ** 2 + t["ry_m"] ** 2 + t["rz_m"] ** 2)
+            axes[1][0].semilogy(t["t_s"], np.maximum(pos, 1e-4), label=variant)
+    axes[0][0].set_ylabel("attitude error [deg]")
+    axes[0][0].set_title(f"{rep.name} ({rep.paper}), lockstep over the bus")
+    if six_dof:
+        axes[1][0].set_ylabel("position error [m]")
+    axes[-1][0].set_xlabel("t [s]")
+    for ax in axes[:, 0]:
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    dest.mkdir(parents=True, exist_ok=True)
+    path = dest / f"{rep.name}.png"
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return [path]
+
+
+def main() -> None:
+    """Parse arguments, run every reproduction and variant, print JSON."""
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--only", action="append", help="run only this reproduction (repeatable)")
+    p.add_argument("--plots", help="write comparison plots (PNG) to this directory")
+    p.add_argument("--keep", help="keep the run folders under this directory")
+    args = p.parse_args()
+    chosen = [r for r in REPRODUCTIONS if not args.only or r.name in args.only]
+    result: dict[str, Any] = {"benchmark": "reproductions", "runs": {}}
+    with tempfile.TemporaryDirectory(prefix="thil-repro-") as tmp:
+        root = Path(args.keep) if args.keep else Path(tmp)
+        for rep in chosen:
+            dirs: dict[str, Path] = {}
+            for variant, sets in rep.variants.items():
+                out = root / rep.name / variant.replace("/", "-")
+                summary = run_scenario(SCENARIOS / rep.scenario, sets, out)
+                result["runs"][f"{rep.name}/{variant}"] = figures(summary, out)
+                dirs[variant] = out
+            if args.plots:
+                result.setdefault("plots", []).extend(
+                    str(x.relative_to(REPO) if x.is_relative_to(REPO) else x)
+                    for x in plot_comparison(rep, dirs, Path(args.plots).resolve())
+                )
+    print(json.dumps(result, indent=2, default=str))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,200 @@
+"""MRP attitude tracking by Duan's direct parametric PD design (seed 001, section 3).
+
+What it does: a PD law on the MRP attitude error with gains chosen so that the closed-loop
+error dynamics are linear, constant and similar to a chosen Hurwitz matrix ``F0`` (6×6).
+
+Error variables: ``ε = σ_BR`` the MRP of the error quaternion ``q_BR = q_RN* ⊗ q_BN``
+(shadow set, ``|ε| ≤ 1``: the short way) and ``ε̇ = F(ε) ω_e`` with the rate error
+``ω_e = ω_BN_B − ω_RN_B`` (:mod:`flight_sw.mrp`). With ``G = F⁻¹``, Euler's equation
+``J ω̇ = τ − ω × Jω`` and ``d/dt(ω_RN_B) = ω̇_RN_B − ω_e × ω_RN_B`` (``ω̇_RN_B`` =
+``domega_RN_B``) become the Lagrange form of seed 001 eq. (3)/(7),
+    ``H(ε) ε̈ + C(ε, ε̇) ε̇ = Gᵀ (τ − n)``,  ``H = GᵀJG``,  ``C = −GᵀJG Ḟ G``,
+    ``n = ω × Jω + J ω̇_RN_B − J (ω_e × ω_RN_B)`` (gyroscopic and reference feed-forward).
+Control (seed 001 section 3, ``T = u_c + u_f``, external signal ``v_c = 0``):
+    ``τ_B = n + Fᵀ(ε) (K0 ε + K1 ε̇)``,  ``[K0 K1] = W V⁻¹`` (eq. (10)),
+    ``V = [Z; Z F0]`` (eq. (9)),  ``W = H Z F0² + C Z F0`` (eq. (11)),
+with ``Z`` (3×6) a free parameter, ``det V ≠ 0`` (eq. (12)). The closed loop is then
+``Ẋ = V F0 V⁻¹ X`` for ``X = [ε; ε̇]`` (Proposition 1), so ``V⁻¹X(t) = e^{F0 t} V⁻¹X(0)``
+exactly for the modelled rigid body, at any error size (until a shadow switch at 180°).
+
+Inputs/outputs: see :class:`flight_sw.control.base.AttitudeController`; torque [N m];
+inertia ``J`` [kg m²] (3×3, body axes, about the centre of mass); ``F0`` [1/s] and ``Z``
+dimensionless. ``domega_RN_B = None`` is taken as zero.
+
+Cases of seed 001 section 5 (:meth:`MrpDirectParametricParams.from_case`):
+``E = blockdiag([[−1, 1], [−1, −1]], −3, −4, −5, −6)``, ``Z = [I3 I3]`` and ``F0 = E``
+(case 1), ``0.5 E`` (case 2), ``2 E`` (case 3).
+
+Deviation from the seed (stated): the seed writes the error as the difference
+``ε = σ − σ_d`` of the body and reference MRPs (eq. (4)) and moves the reference into
+``u_f``. Here the error is the relative MRP ``σ_BR`` (identical when R = N, i.e. for
+regulation), which needs no reference MRP near the shadow boundary and keeps ``q`` and
+``−q`` equivalent; the reference motion enters through ``n``. The gravity-gradient term
+``g`` of eq. (3) is omitted (a disturbance here: no orbit model in this law).
+
+Assumptions: rigid body, exact ``J`` for the exact closed loop (``set_inertia_B_kgm2``
+takes an identified one); unit quaternions; rates measured; no actuator limits.
+
+Sources: seed 001 (Attitude control and structure robust control allocation for combined
+spacecraft), eq. (1)–(12), Proposition 1, section 5 cases 1–3; Duan 2014, "Satellite
+attitude control — a direct parametric approach" (the method of seed 001's ref. [13]).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import block_diag
+
+from dbc.errors import ConfigError
+from flight_sw import mrp
+from flight_sw.quaternion import error_quaternion
+
+N_AXES = 3
+N_STATES = 2 * N_AXES
+# Seed 001 section 5: E = blockdiag([[−1, 1], [−1, −1]], −3, −4, −5, −6) [1/s].
+SEED001_E_OSCILLATORY_BLOCK = ((-1.0, 1.0), (-1.0, -1.0))
+SEED001_E_REAL_EIGENVALUES = (-3.0, -4.0, -5.0, -6.0)
+# F0 = scale · E for cases 1, 2, 3.
+SEED001_CASE_F0_SCALE = {1: 1.0, 2: 0.5, 3: 2.0}
+# V = [Z; Z F0] is rejected as singular above this condition number.
+MAX_V_CONDITION = 1e10
+# Inertia symmetry tolerance, relative to its largest element.
+INERTIA_SYMMETRY_RTOL = 1e-9
+
+_SOURCE = "MrpDirectParametricParams"
+
+Matrix = tuple[tuple[float, ...], ...]
+
+
+def _matrix(source: str, key: str, value: object, rows: int, cols: int) -> np.ndarray:
+    expected = f"a {rows}x{cols} matrix of finite numbers"
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(source, key, value, expected) from None
+    if arr.shape != (rows, cols) or not np.all(np.isfinite(arr)):
+        raise ConfigError(source, key, value, expected)
+    return arr
+
+
+def _as_tuple(arr: np.ndarray) -> Matrix:
+    return tuple(tuple(float(x) for x in row) for row in arr)
+
+
+def seed001_e() -> np.ndarray:
+    """The matrix E of seed 001 section 5 (6×6, eigenvalues −1 ± i, −3, −4, −5, −6)."""
+    return np.asarray(
+        block_diag(np.array(SEED001_E_OSCILLATORY_BLOCK), *SEED001_E_REAL_EIGENVALUES),
+        dtype=float,
+    )
+
+
+def inertia_matrix(inertia_B_kgm2: object) -> np.ndarray:
+    """``inertia_B_kgm2`` as a validated 3×3 symmetric positive definite array [kg m²]."""
+    j = _matrix("inertia", "inertia_B_kgm2", inertia_B_kgm2, N_AXES, N_AXES)
+    scale = float(np.max(np.abs(j)))
+    if not np.allclose(j, j.T, rtol=0.0, atol=INERTIA_SYMMETRY_RTOL * scale):
+        raise ValueError(f"inertia_B_kgm2 = {j.tolist()!r}: expected a symmetric matrix")
+    if not float(np.min(np.linalg.eigvalsh(j))) > 0.0:
+        raise ValueError(f"inertia_B_kgm2 = {j.tolist()!r}: expected a positive definite matrix")
+    return 0.5 * (j + j.T)
+
+
+@dataclass(frozen=True)
+class MrpDirectParametricParams:
+    """The design of the direct parametric law.
+
+    Attributes:
+        f0: the desired closed-loop matrix F0 (6×6) [1/s], Hurwitz.
+        z: the free parameter Z (3×6), with ``V = [Z; Z F0]`` nonsingular (eq. (12)).
+    """
+
+    f0: Matrix
+    z: Matrix
+
+    def __post_init__(self) -> None:
+        f0 = _matrix(_SOURCE, "f0", self.f0, N_STATES, N_STATES)
+        z = _matrix(_SOURCE, "z", self.z, N_AXES, N_STATES)
+        if not float(np.max(np.linalg.eigvals(f0).real)) < 0.0:
+            raise ConfigError(_SOURCE, "f0", self.f0, "a Hurwitz matrix (eigenvalues Re < 0)")
+        v = np.vstack((z, z @ f0))
+        if not float(np.linalg.cond(v)) < MAX_V_CONDITION:
+            raise ConfigError(_SOURCE, "z", self.z, "Z with [Z; Z F0] nonsingular (eq. (12))")
+        object.__setattr__(self, "f0", _as_tuple(f0))
+        object.__setattr__(self, "z", _as_tuple(z))
+
+    @classmethod
+    def from_case(cls, case: int) -> MrpDirectParametricParams:
+        """Case 1, 2 or 3 of seed 001 section 5: ``F0 = E, 0.5 E, 2 E``, ``Z = [I3 I3]``."""
+        if isinstance(case, bool) or case not in SEED001_CASE_F0_SCALE:
+            raise ConfigError(_SOURCE, "case", case, "1, 2 or 3 (seed 001 section 5)")
+        f0 = SEED001_CASE_F0_SCALE[case] * seed001_e()
+        z = np.hstack((np.eye(N_AXES), np.eye(N_AXES)))
+        return cls(f0=_as_tuple(f0), z=_as_tuple(z))
+
+    def v_matrix(self) -> np.ndarray:
+        """``V = [Z; Z F0]`` (eq. (9)), 6×6."""
+        z = np.array(self.z)
+        return np.vstack((z, z @ np.array(self.f0)))
+
+    def closed_loop_matrix(self) -> np.ndarray:
+        """``V F0 V⁻¹``: the constant closed-loop matrix of ``X = [ε; ε̇]`` (Proposition 1)."""
+        v = self.v_matrix()
+        return np.asarray(v @ np.array(self.f0) @ np.linalg.inv(v))
+
+
+class MrpDirectParametric:
+    """Direct parametric MRP tracking law (implements ``AttitudeController``, ``InertiaAware``)."""
+
+    def __init__(self, params: MrpDirectParametricParams, inertia_B_kgm2: np.ndarray) -> None:
+        self._params = params
+        f0 = np.array(params.f0)
+        z = np.array(params.z)
+        v_inv = np.linalg.inv(params.v_matrix())
+        # K0 ε + K1 ε̇ = H (Z F0² V⁻¹ X) + C (Z F0 V⁻¹ X), from eq. (10)–(11).
+        self._zf0sq_vinv = z @ f0 @ f0 @ v_inv
+        self._zf0_vinv = z @ f0 @ v_inv
+        self._inertia = inertia_matrix(inertia_B_kgm2)
+
+    @property
+    def params(self) -> MrpDirectParametricParams:
+        """The design this controller was built with."""
+        return self._params
+
+    @property
+    def inertia_B_kgm2(self) -> np.ndarray:
+        """The inertia model in use [kg m²] (a copy)."""
+        return self._inertia.copy()
+
+    def set_inertia_B_kgm2(self, inertia_B_kgm2: np.ndarray) -> None:
+        """Use ``inertia_B_kgm2`` (3×3, symmetric positive definite) from now on."""
+        self._inertia = inertia_matrix(inertia_B_kgm2)
+
+    def torque_B_Nm(
+        self,
+        t_ns: int,
+        q_BN: np.ndarray,
+        omega_BN_B: np.ndarray,
+        q_RN: np.ndarray,
+        omega_RN_B: np.ndarray,
+        domega_RN_B: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """``τ_B = n + Fᵀ(ε)(K0 ε + K1 ε̇)`` [N m] (module docstring)."""
+        j = self._inertia
+        omega = np.asarray(omega_BN_B, dtype=float)
+        omega_ref = np.asarray(omega_RN_B, dtype=float)
+        omega_err = omega - omega_ref
+        eps = mrp.from_quaternion(error_quaternion(q_RN, q_BN))
+        f = mrp.kinematics_matrix(eps)
+        eps_dot = f @ omega_err
+        g = mrp.kinematics_matrix_inverse(eps)
+        h = g.T @ j @ g
+        c = -h @ mrp.kinematics_matrix_rate(eps, eps_dot) @ g
+        x = np.concatenate((eps, eps_dot))
+        generalised_Nm = h @ (self._zf0sq_vinv @ x) + c @ (self._zf0_vinv @ x)
+        n = np.cross(omega, j @ omega) - j @ np.cross(omega_err, omega_ref)
+        if domega_RN_B is not None:
+            n = n + j @ np.asarray(domega_RN_B, dtype=float)
+        return np.asarray(n + f.T @ generalised_Nm)

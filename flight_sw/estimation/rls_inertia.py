@@ -1,0 +1,294 @@
+"""Recursive-least-squares identification of the inertia tensor (seed 001, §2).
+
+What it does: identifies the six unique entries of the inertia tensor
+``θ = (J11, J12, J13, J22, J23, J33)`` [kg m²] (body axes, about the centre of mass) from
+the body rate and the torque applied, with the RLS algorithm with forgetting factor of
+seed 001 §2. Euler's equation (seed 001 eq. (2), ``J ω̇ + ω × J ω = T``) is linear in θ:
+``J ω = Ω(ω) θ`` with
+    ``Ω(ω) = [[ω1, ω2, ω3, 0, 0, 0], [0, ω1, 0, ω2, ω3, 0], [0, 0, ω1, 0, ω2, ω3]]``
+(seed 001's ``J_m ω_m = Ω_m i_m``; its ``i_m`` is garbled in the text as
+``[J11 J12 J13 J11 J22 J33]``, the unique entries are meant).
+
+Regressor (the seed's increment form): the seed regresses on increments ``Δ`` between
+``t_{k−1}`` and ``t_k`` (momentum form) rather than on differentiated rates. Integrating
+eq. (2) over one control period ``h = t_k − t_{k−1}``:
+    ``Ω(ω_k − ω_{k−1}) θ + ∫ [ω×] Ω(ω) θ dt = ∫ T dt = h T̄_k``,
+where ``T̄_k`` is the mean torque applied over the period (exact in impulse whatever the
+pulse shape inside the period). The gyroscopic integral is taken by the trapezoidal rule
+(error O(h³), relative ``≈ (|ω̇| h)²/12``). Divided by ``h`` this gives the measurement
+equation ``y_k = Φ_k θ`` in torque units:
+    ``Φ_k = Ω((ω_k − ω_{k−1})/h) + ½ ([ω_{k−1}×] Ω(ω_{k−1}) + [ω_k×] Ω(ω_k))``,  ``y_k = T̄_k``.
+
+RLS update (seed 001 §2, the three equations after "the RLS algorithm to compute the
+updates for θ(t)", with ``Φ`` 3×6 so its ``P Φ`` reads ``P Φᵀ``):
+    ``K_k = P_{k−1} Φ_kᵀ [λ I3 + Φ_k P_{k−1} Φ_kᵀ]⁻¹``,
+    ``θ_k = θ_{k−1} + K_k (y_k − Φ_k θ_{k−1})``,
+    ``P_k = (I6 − K_k Φ_k) P_{k−1} / λ``;
+``P_0 = α I6`` (Remark 1: α > 1; λ close to 1). ``P`` is re-symmetrised after every step
+and, against covariance wind-up when λ < 1 and the motion does not excite some direction,
+scaled down whenever its trace exceeds that of ``P_0`` (constant-trace bound).
+
+Excitation: the identifier also keeps the discounted information matrix
+``R_k = λ R_{k−1} + Φ_kᵀ Φ_k`` [(rad/s²)²]; :meth:`RlsInertiaIdentifier.update` returns
+the estimate only while ``λ_min(R_k) ≥ min_information`` and the estimate is positive
+definite, else None (so a caller keeps its last good inertia). With a torque-equation
+residual of standard deviation σ_T [N m], the estimate's standard deviation is about
+``σ_T / sqrt(λ_min(R))`` [kg m²]. Steps whose regressor is weaker than
+``min_regressor_norm`` (Frobenius norm) are skipped entirely (no forgetting either).
+
+Inputs: ``update(t_ns, omega_BN_B, torque_B_Nm)`` once per control cycle: time [ns], the
+(estimated) body rate at ``t_ns`` [rad/s], and the mean torque about the centre of mass
+actually applied over the period that ended at ``t_ns`` [N m], body axes.
+Output: the symmetric 3×3 estimate [kg m²] or None.
+
+Assumptions: rigid body (seed 001 §2: manipulator joints locked after capture), no
+external torque other than the control torque, body axes fixed in the body (the seed
+works in the principal-axis frame; products of inertia are identified here as well). The
+torque passed in is trusted: if the thrusters deliver a different torque (modulation
+rounding, a failed valve), the estimate is biased accordingly. Noise on the rate enters
+the regressor as well (errors in variables), which biases the estimate by about the
+ratio of the rate-difference noise power to the excitation power.
+
+Source: seed 001 ("Attitude control and structure robust control allocation for combined
+spacecraft"), §2: Euler
+equation (2), the RLS equations with forgetting factor and Remark 1; the regressor
+parametrisation of the momentum-based identification the seed cites as [7].
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from dbc.errors import ConfigError
+from flight_sw.quaternion import skew
+
+N_PARAMS = 6  # unique entries of a symmetric 3×3 tensor
+N_AXES = 3
+NS_PER_S = 1_000_000_000
+# (row, column) of each entry of θ = (J11, J12, J13, J22, J23, J33)
+THETA_INDEX = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+# Relative asymmetry tolerated in a configured inertia guess.
+SYMMETRY_RTOL = 1e-9
+TRAPEZOID_WEIGHT = 0.5
+
+DEFAULT_FORGETTING_FACTOR = 0.999  # memory ≈ 1/(1 − λ) = 1000 cycles (20 s at 50 Hz)
+DEFAULT_INITIAL_COVARIANCE = 1.0e6  # α [(kg m²)²]: a weak prior (seed 001 Remark 1: α > 1)
+DEFAULT_MIN_INFORMATION = 1.0e-2  # [(rad/s²)²]
+DEFAULT_MIN_REGRESSOR_NORM = 0.0  # [rad/s²]: 0 = every step is used
+DEFAULT_MAX_GAP_S = 1.0  # a longer gap between samples restarts the differencing
+
+_SOURCE = "RlsInertiaParams"
+
+
+def _real(key: str, value: object, expected: str) -> float:
+    if not (isinstance(value, numbers.Real) and not isinstance(value, bool)):
+        raise ConfigError(_SOURCE, key, value, expected)
+    x = float(value)
+    if not math.isfinite(x):
+        raise ConfigError(_SOURCE, key, value, expected)
+    return x
+
+
+def inertia_matrix(theta: np.ndarray) -> np.ndarray:
+    """The symmetric 3×3 tensor [kg m²] of ``θ = (J11, J12, J13, J22, J23, J33)``."""
+    j11, j12, j13, j22, j23, j33 = np.asarray(theta, dtype=float).tolist()
+    return np.array([[j11, j12, j13], [j12, j22, j23], [j13, j23, j33]])
+
+
+def inertia_params(inertia_kgm2: np.ndarray) -> np.ndarray:
+    """``θ = (J11, J12, J13, J22, J23, J33)`` of a 3×3 tensor (upper triangle, row order)."""
+    j = np.asarray(inertia_kgm2, dtype=float)
+    return np.array([j[r, c] for r, c in THETA_INDEX])
+
+
+def momentum_regressor(omega_B: np.ndarray) -> np.ndarray:
+    """``Ω(ω)`` (3×6) with ``J ω = Ω(ω) θ``."""
+    w1, w2, w3 = np.asarray(omega_B, dtype=float).tolist()
+    return np.array(
+        [
+            [w1, w2, w3, 0.0, 0.0, 0.0],
+            [0.0, w1, 0.0, w2, w3, 0.0],
+            [0.0, 0.0, w1, 0.0, w2, w3],
+        ]
+    )
+
+
+def euler_regressor(omega_prev_B: np.ndarray, omega_B: np.ndarray, dt_s: float) -> np.ndarray:
+    """``Φ`` (3×6) of the period-integrated Euler equation, ``Φ θ ≈ mean torque`` [N m].
+
+    ``Φ = Ω((ω − ω_prev)/dt) + ½([ω_prev×] Ω(ω_prev) + [ω×] Ω(ω))`` (module docstring).
+    """
+    w0 = np.asarray(omega_prev_B, dtype=float)
+    w1 = np.asarray(omega_B, dtype=float)
+    gyro = skew(w0) @ momentum_regressor(w0) + skew(w1) @ momentum_regressor(w1)
+    return momentum_regressor((w1 - w0) / dt_s) + TRAPEZOID_WEIGHT * gyro
+
+
+def _inertia_tuple(value: object) -> tuple[tuple[float, float, float], ...]:
+    expected = "a symmetric positive-definite 3×3 matrix of finite numbers [kg m²]"
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected) from None
+    if arr.shape != (N_AXES, N_AXES) or not np.all(np.isfinite(arr)):
+        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
+    scale = float(np.max(np.abs(arr)))
+    if not np.allclose(arr, arr.T, rtol=0.0, atol=SYMMETRY_RTOL * scale):
+        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
+    sym = 0.5 * (arr + arr.T)
+    if not float(np.linalg.eigvalsh(sym)[0]) > 0.0:
+        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
+    return tuple((float(r[0]), float(r[1]), float(r[2])) for r in sym)
+
+
+@dataclass(frozen=True)
+class RlsInertiaParams:
+    """RLS inertia-identification parameters.
+
+    Attributes:
+        inertia_guess_B_kgm2: initial estimate θ_0 (3×3, symmetric, positive definite)
+            [kg m²], body axes about the centre of mass; stored as a tuple of rows.
+        forgetting_factor: λ in (0, 1] (1: no forgetting).
+        initial_covariance: α > 0 in P_0 = α I6 [(kg m²)²]; the prior weighs 1/α.
+        min_information: the estimate is returned only while λ_min(R) ≥ this
+            [(rad/s²)²] (≥ 0; 0: as soon as the estimate is positive definite).
+        min_regressor_norm: steps with ‖Φ‖_F below this are skipped [rad/s²] (≥ 0).
+        max_gap_s: a gap between samples above this [s] (> 0) restarts the differencing.
+    """
+
+    inertia_guess_B_kgm2: Sequence[Sequence[float]] | np.ndarray
+    forgetting_factor: float = DEFAULT_FORGETTING_FACTOR
+    initial_covariance: float = DEFAULT_INITIAL_COVARIANCE
+    min_information: float = DEFAULT_MIN_INFORMATION
+    min_regressor_norm: float = DEFAULT_MIN_REGRESSOR_NORM
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "inertia_guess_B_kgm2", _inertia_tuple(self.inertia_guess_B_kgm2))
+        lam = _real("forgetting_factor", self.forgetting_factor, "a number in (0, 1]")
+        if not 0.0 < lam <= 1.0:
+            raise ConfigError(_SOURCE, "forgetting_factor", self.forgetting_factor, "in (0, 1]")
+        alpha = _real("initial_covariance", self.initial_covariance, "a finite number > 0")
+        if alpha <= 0.0:
+            raise ConfigError(
+                _SOURCE, "initial_covariance", self.initial_covariance, "a finite number > 0"
+            )
+        for key in ("min_information", "min_regressor_norm"):
+            value = getattr(self, key)
+            if _real(key, value, "a finite number >= 0") < 0.0:
+                raise ConfigError(_SOURCE, key, value, "a finite number >= 0")
+        if _real("max_gap_s", self.max_gap_s, "a finite number > 0 [s]") <= 0.0:
+            raise ConfigError(_SOURCE, "max_gap_s", self.max_gap_s, "a finite number > 0 [s]")
+
+
+class RlsInertiaIdentifier:
+    """RLS identifier of the inertia tensor (implements ``InertiaIdentifier``)."""
+
+    def __init__(self, params: RlsInertiaParams) -> None:
+        self._params = params
+        self._theta = inertia_params(np.array(params.inertia_guess_B_kgm2))
+        self._p = np.eye(N_PARAMS) * params.initial_covariance
+        self._info = np.zeros((N_PARAMS, N_PARAMS))
+        self._prev: tuple[int, np.ndarray] | None = None
+        self._n_updates = 0
+
+    @property
+    def params(self) -> RlsInertiaParams:
+        """The parameters this identifier was built with."""
+        return self._params
+
+    @property
+    def inertia_B_kgm2(self) -> np.ndarray:
+        """The current estimate (3×3, symmetric) [kg m²], whether excited or not."""
+        return inertia_matrix(self._theta)
+
+    @property
+    def covariance(self) -> np.ndarray:
+        """A copy of P (6×6) [(kg m²)²] in the order of θ."""
+        return self._p.copy()
+
+    @property
+    def min_information(self) -> float:
+        """λ_min of the discounted information matrix R [(rad/s²)²]."""
+        return float(np.linalg.eigvalsh(self._info)[0])
+
+    @property
+    def n_updates(self) -> int:
+        """RLS steps taken since construction or the last reset."""
+        return self._n_updates
+
+    def reset(self, inertia_guess_B_kgm2: np.ndarray | None = None) -> None:
+        """Restart after a known mass-property change (e.g. a capture).
+
+        ``inertia_guess_B_kgm2`` (3×3) replaces the estimate; None keeps the current one
+        and only resets the covariance to ``α I6`` (re-opens the identifier). The
+        information and the previous rate sample are cleared either way (the period
+        across the change is not used).
+        """
+        if inertia_guess_B_kgm2 is not None:
+            guess = np.array(_inertia_tuple(inertia_guess_B_kgm2))
+            self._theta = inertia_params(guess)
+        self._p = np.eye(N_PARAMS) * self._params.initial_covariance
+        self._info = np.zeros((N_PARAMS, N_PARAMS))
+        self._prev = None
+        self._n_updates = 0
+
+    def update(
+        self, t_ns: int, omega_BN_B: np.ndarray, torque_B_Nm: np.ndarray
+    ) -> np.ndarray | None:
+        """Take the rate at ``t_ns`` and the mean torque of the period ending at ``t_ns``.
+
+        Returns the current estimate (3×3) [kg m²] if excited enough and positive
+        definite, else None. A non-finite input, a non-increasing time or a gap above
+        ``max_gap_s`` drops the pair of samples (the differencing restarts).
+        """
+        w = np.array(omega_BN_B, dtype=float).reshape(N_AXES)
+        tau = np.array(torque_B_Nm, dtype=float).reshape(N_AXES)
+        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(tau))):
+            self._prev = None
+            return self._output()
+        prev = self._prev
+        self._prev = (t_ns, w)
+        if prev is None:
+            return self._output()
+        dt_s = (t_ns - prev[0]) / NS_PER_S
+        if not 0.0 < dt_s <= self._params.max_gap_s:
+            return self._output()
+        phi = euler_regressor(prev[1], w, dt_s)
+        if float(np.linalg.norm(phi)) < self._params.min_regressor_norm:
+            return self._output()
+        self._step(phi, tau)
+        return self._output()
+
+    def _step(self, phi: np.ndarray, y: np.ndarray) -> None:
+        """One RLS step (seed 001 §2) with the constant-trace bound on P."""
+        lam = self._params.forgetting_factor
+        p = self._p
+        p_phi_t = p @ phi.T
+        s = lam * np.eye(N_AXES) + phi @ p_phi_t
+        gain = np.linalg.solve(s, p_phi_t.T).T  # P Φᵀ S⁻¹ (S symmetric)
+        self._theta = self._theta + gain @ (y - phi @ self._theta)
+        p = (p - gain @ phi @ p) / lam
+        p = 0.5 * (p + p.T)
+        trace_cap = N_PARAMS * self._params.initial_covariance
+        trace = float(np.trace(p))
+        if trace > trace_cap:
+            p *= trace_cap / trace
+        self._p = p
+        self._info = lam * self._info + phi.T @ phi
+        self._n_updates += 1
+
+    def _output(self) -> np.ndarray | None:
+        if self._n_updates == 0:
+            return None
+        if float(np.linalg.eigvalsh(self._info)[0]) < self._params.min_information:
+            return None
+        j = inertia_matrix(self._theta)
+        if not float(np.linalg.eigvalsh(j)[0]) > 0.0:
+            return None
+        return j

@@ -1,0 +1,1 @@
+"""Attitude guidance: the reference attitude, rate and angular acceleration over time."""

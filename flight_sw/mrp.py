@@ -1,0 +1,101 @@
+"""Modified Rodrigues parameters (MRP): conversions, shadow set and kinematics, pure functions.
+
+What it does: the MRP ``σ = e tan(φ/4)`` of a rotation by ``φ`` about the unit axis ``e``;
+conversion from and to the project's scalar-first quaternions, the shadow set, and the
+kinematics matrix ``F(σ)`` of ``σ̇ = F(σ) ω`` with its inverse and time derivative.
+
+Formulas (``s = σᵀσ``, ``[σ×]`` the cross-product matrix):
+- ``σ = q_vec / (1 + q0)``; ``q0 = (1 − s)/(1 + s)``, ``q_vec = 2σ/(1 + s)``;
+- shadow set ``σˢ = −σ/s``: the same attitude (it is ``−q``); :func:`from_quaternion`
+  returns the representative with ``|σ| ≤ 1`` (rotation ≤ 180°, the short way);
+- ``F(σ) = ¼ [(1 − s) I + 2 [σ×] + 2 σσᵀ]`` (seed 001 eq. (1));
+- ``F⁻¹(σ) = 16/(1 + s)² F(σ)ᵀ`` (seed 001, below eq. (1); named ``G`` there);
+- ``Ḟ(σ, σ̇) = ½ [−(σᵀσ̇) I + [σ̇×] + σ̇σᵀ + σσ̇ᵀ]`` (term-by-term derivative of ``F``).
+
+Conventions: a quaternion ``q_BN`` (maps N to B, see :mod:`flight_sw.quaternion`) gives
+``σ_BN`` with ``σ̇_BN = F(σ_BN) ω_BN_B`` (ω in body axes [rad/s]); the DCM is the
+quaternion's, ``C(σ) = I + (8[σ×]² − 4(1 − s)[σ×])/(1 + s)²``.
+
+Inputs/outputs: float64 numpy arrays, shape (3,) for MRP and rates, (4,) for quaternions,
+(3, 3) for matrices; MRP are dimensionless, rates in rad/s.
+
+Assumptions: unit quaternions; :func:`to_quaternion` and the kinematics accept any finite
+σ (the shadow switch is the caller's, via :func:`from_quaternion` or :func:`switched`).
+
+Sources: seed 001 (MRP kinematics eq. (1) and ``F⁻¹``); Schaub & Junkins 2018,
+"Analytical Mechanics of Space Systems", 4th ed., §3.8 (MRP, shadow set, ``B(σ) = 4F(σ)``,
+the DCM in terms of σ).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flight_sw.quaternion import skew
+
+# |σ| above which :func:`switched` maps to the shadow set (σ and σˢ coincide at |σ| = 1).
+SHADOW_SWITCH_NORM_SQ = 1.0
+# F(σ) = KINEMATICS_SCALE · B(σ) with Schaub's B(σ) = (1 − s) I + 2[σ×] + 2σσᵀ.
+KINEMATICS_SCALE = 0.25
+# F⁻¹(σ) = INVERSE_SCALE / (1 + s)² · F(σ)ᵀ.
+INVERSE_SCALE = 16.0
+
+
+def shadow(sigma: np.ndarray) -> np.ndarray:
+    """The shadow MRP ``σˢ = −σ/|σ|²`` (same attitude); raises ``ValueError`` for σ = 0."""
+    s = np.asarray(sigma, dtype=float)
+    norm_sq = float(s @ s)
+    if norm_sq == 0.0:
+        raise ValueError("the zero MRP has no shadow (its shadow is at infinity)")
+    return -s / norm_sq
+
+
+def switched(sigma: np.ndarray) -> np.ndarray:
+    """``σ`` if ``|σ| ≤ 1``, else its shadow ``σˢ``: the representative of rotation ≤ 180°."""
+    s = np.asarray(sigma, dtype=float)
+    return shadow(s) if float(s @ s) > SHADOW_SWITCH_NORM_SQ else s.copy()
+
+
+def from_quaternion(q: np.ndarray) -> np.ndarray:
+    """The MRP of the unit quaternion ``q`` with ``|σ| ≤ 1`` (``q`` and ``−q`` agree)."""
+    qa = np.asarray(q, dtype=float)
+    if qa[0] < 0.0:
+        qa = -qa
+    return qa[1:] / (1.0 + qa[0])
+
+
+def to_quaternion(sigma: np.ndarray) -> np.ndarray:
+    """The unit quaternion ``((1 − s)/(1 + s), 2σ/(1 + s))`` of σ; ``q0 ≥ 0`` iff ``|σ| ≤ 1``."""
+    s = np.asarray(sigma, dtype=float)
+    norm_sq = float(s @ s)
+    denom = 1.0 + norm_sq
+    return np.concatenate(([(1.0 - norm_sq) / denom], 2.0 * s / denom))
+
+
+def to_dcm(sigma: np.ndarray) -> np.ndarray:
+    """``C(σ) = I + (8[σ×]² − 4(1 − s)[σ×])/(1 + s)²``, equal to the quaternion's DCM."""
+    s = np.asarray(sigma, dtype=float)
+    norm_sq = float(s @ s)
+    sk = skew(s)
+    return np.eye(3) + (8.0 * sk @ sk - 4.0 * (1.0 - norm_sq) * sk) / (1.0 + norm_sq) ** 2
+
+
+def kinematics_matrix(sigma: np.ndarray) -> np.ndarray:
+    """``F(σ) = ¼[(1 − s) I + 2[σ×] + 2σσᵀ]`` with ``σ̇ = F(σ) ω`` (seed 001 eq. (1))."""
+    s = np.asarray(sigma, dtype=float)
+    norm_sq = float(s @ s)
+    return KINEMATICS_SCALE * ((1.0 - norm_sq) * np.eye(3) + 2.0 * skew(s) + 2.0 * np.outer(s, s))
+
+
+def kinematics_matrix_inverse(sigma: np.ndarray) -> np.ndarray:
+    """``G(σ) = F⁻¹(σ) = 16/(1 + s)² F(σ)ᵀ``, so ``ω = G(σ) σ̇`` (seed 001)."""
+    s = np.asarray(sigma, dtype=float)
+    norm_sq = float(s @ s)
+    return INVERSE_SCALE / (1.0 + norm_sq) ** 2 * kinematics_matrix(s).T
+
+
+def kinematics_matrix_rate(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
+    """``Ḟ(σ, σ̇) = ½[−(σᵀσ̇) I + [σ̇×] + σ̇σᵀ + σσ̇ᵀ]``, the time derivative of ``F(σ(t))``."""
+    s = np.asarray(sigma, dtype=float)
+    sd = np.asarray(sigma_dot, dtype=float)
+    return 0.5 * (-float(s @ sd) * np.eye(3) + skew(sd) + np.outer(sd, s) + np.outer(s, sd))
