@@ -61,6 +61,24 @@ def pointing_metrics(
     )
 
 
+def settling_time_s(
+    t_s: np.ndarray, err: np.ndarray, band: float, t_start_s: float = 0.0
+) -> float | None:
+    """First time (from ``t_start_s``) after which ``err`` stays within ``band``; None if never.
+
+    Same rule as the attitude settling time of ``pointing_metrics`` (e.g. for the position
+    error [m] against ``position_band_m``).
+    """
+    if len(t_s) == 0:
+        return None
+    outside = np.nonzero(err > band)[0]
+    if len(outside) == 0:
+        return 0.0
+    if outside[-1] == len(t_s) - 1:
+        return None
+    return float(t_s[outside[-1] + 1] - t_start_s)
+
+
 def latency_summary(samples_ns: list[int]) -> dict[str, Any]:
     """p50, p99, max in microseconds and the sample count."""
     if not samples_ns:

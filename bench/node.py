@@ -31,9 +31,10 @@ from cantools.database.can import Database
 
 from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_time_ns
 from bench.faults import BUS_KINDS, NO_FATE, FaultSpec, fault_from_command, frame_fate
-from bench.metrics import expectation, latency_summary, pointing_metrics
+from bench.metrics import expectation, latency_summary, pointing_metrics, settling_time_s
 from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
+from bench.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
 from bench.scenario import Scenario
 from dbc.codec import Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.errors import RunError
@@ -167,7 +168,8 @@ class BenchNode:
         )
         self._nav_vel: tuple[tuple[float, float, float], bool] = ((0.0, 0.0, 0.0), False)
         self.tick_ns = math.gcd(TELEMETRY_PERIOD_NS, *self.sensor_period_ns.values())
-        self.plant = Plant(sc, seed, self.sensor_period_ns["IMU_RATE"])
+        self.plant = Plant(sc, seed, self.sensor_period_ns["IMU_RATE"], self.period_ns)
+        self.events_log: list[dict[str, Any]] = []
         self.n_thr = len(sc.thrusters)
         self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
         self.arbiter = BusArbiter(sc.bus.bitrate_bps)
@@ -211,7 +213,8 @@ class BenchNode:
         self.tel_t: list[float] = []
         self.tel_err: list[float] = []
         self.tel_rate_err: list[float] = []
-        self.tel_pos_err: list[float] = []  # position hold: distance from the initial position
+        # distance from the reference position ([manoeuvre] r_target_N_m, else the initial one)
+        self.tel_pos_err: list[float] = []
         self.wall_s = 0.0
         self.fsw_alive: Callable[[], bool] | None = None
         self._wire_pending: dict[int, tuple[can.Message, bool, int]] = {}
@@ -250,8 +253,15 @@ class BenchNode:
     def _telemetry_row(self, t_ns: int) -> None:
         s = self.plant.state
         q = s[0:4]
-        err = quat_error_deg(q, self.sc.q_target_BN)
-        rate_err = math.sqrt(s[4] ** 2 + s[5] ** 2 + s[6] ** 2) * RAD_DEG
+        if self.sc.reference.kind == KIND_STEP:
+            err = quat_error_deg(q, self.sc.q_target_BN)
+            rate_err = math.sqrt(s[4] ** 2 + s[5] ** 2 + s[6] ** 2) * RAD_DEG
+        else:  # a moving reference: errors w.r.t. q_RN(t), omega_RN(t) (bench/reference.py)
+            q_ref, w_ref = reference(self.sc.reference, t_ns / NS_PER_S)
+            q_t = (s[0], s[1], s[2], s[3])
+            err = attitude_error_deg(q_t, q_ref)
+            dw = rate_error_B(q_t, (s[4], s[5], s[6]), q_ref, w_ref)
+            rate_err = math.sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2) * RAD_DEG
         fq = self.fsw_q_est if (self.fsw_q_est and self.fsw_q_valid) else None
         est_err = self.fsw_est_err_deg if fq else float("nan")
         thr = self.plant.thrusters
@@ -266,7 +276,7 @@ class BenchNode:
             self.tel_t.append(t_ns / NS_PER_S)
             self.tel_err.append(err)
             self.tel_rate_err.append(rate_err)
-            self.tel_pos_err.append(math.dist(s[7:10], self.sc.r0_N_m))
+            self.tel_pos_err.append(math.dist(s[7:10], self.sc.r_reference_N_m))
 
     # -- sensors -----------------------------------------------------------------
     def _sample(self, name: str, t_ns: int) -> dict[str, float | int]:
@@ -350,6 +360,13 @@ class BenchNode:
         self.faults_log.append(rec)
         self.trace.event(t_ns, "fault_injected", **rec)
 
+    def _record_events(self) -> None:
+        """Log the plant's newly applied mass-property events (events.jsonl, summary)."""
+        for t_ns, e in self.plant.applied_events[len(self.events_log):]:
+            rec = {**e.record(), "applied_t_s": t_ns / NS_PER_S}
+            self.events_log.append(rec)
+            self.trace.event(t_ns, "capture", **rec)
+
     def _sensor(self, name: str) -> Any:
         return {"gyro": self.plant.gyro, "accelerometer": self.plant.accel,
                 "star_tracker": self.plant.star}[name]
@@ -410,6 +427,8 @@ class BenchNode:
         while self.plant.t_ns < t_end_ns:
             t = min(t_end_ns, self._next_event_ns(self.plant.t_ns))
             self.plant.advance_to(t)
+            if len(self.plant.applied_events) > len(self.events_log):
+                self._record_events()
             self._faults_due(t)
             if self.delayed:
                 self._release_delayed(t)
@@ -815,6 +834,10 @@ class BenchNode:
         pos, t_arr = np.asarray(self.tel_pos_err), np.asarray(self.tel_t)
         pos_final = float(pos[-1]) if len(pos) else 0.0
         pos_ss = float(pos[t_arr >= t_arr[-1] - e.steady_state_window_s].max()) if len(pos) else 0.0
+        pos_settling = (
+            settling_time_s(t_arr, pos, e.position_band_m, sc.manoeuvre_start_s)
+            if e.position_band_m is not None else None
+        )
         exps = [
             x
             for x in (
@@ -832,6 +855,8 @@ class BenchNode:
                 expectation("steady_state_position_error_m", pos_ss,
                             e.steady_state_position_error_m_max),
                 expectation("final_position_error_m", pos_final, e.final_position_error_m_max),
+                expectation("position_settling_time_s", pos_settling,
+                            e.position_settling_time_s_max),
             )
             if x is not None
         ]
@@ -855,6 +880,12 @@ class BenchNode:
             "final_attitude_error_deg": pm.final_attitude_error_deg,
             "final_position_error_m": pos_final,
             "steady_state_position_error_m": pos_ss,
+            "position_band_m": e.position_band_m,
+            "position_settling_time_s": pos_settling,
+            "reference_kind": sc.reference.kind,
+            "translation": sc.dynamics.translation,
+            "valve_model": sc.valve.model,
+            "events": self.events_log,
             "propellant_kg": thr.total_propellant_kg,
             "valve_openings": {"total": int(sum(thr.openings)), "per_thruster": list(thr.openings)},
             "frames": frames,

@@ -20,8 +20,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from bench.dynamics.hcw import SEED000_ORBIT_RADIUS_M
+from bench.environment.disturbance import FORCE_FRAMES, DisturbanceParams, Sinusoid
 from bench.faults import FaultSpec, parse_faults
-from bench.valves.layouts import LAYOUTS
+from bench.reference import KIND_STEP, KINDS, ReferenceParams, reference
+from bench.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
 from dbc import load_database
 from dbc.errors import ConfigError
 from dbc.schema import Table
@@ -35,6 +38,13 @@ DEG_RAD = math.pi / 180.0
 SQRT_HOUR_S = 60.0  # sqrt(3600 s)
 UNIT_NORM_TOL = 1e-6
 MODES = ("lockstep", "realtime")
+TRANSLATIONS = ("inertial", "hcw")
+"""[dynamics] translation: inertial (default) or HCW relative motion (bench.dynamics.hcw)."""
+VALVE_MODELS = ("on_off", "throttled")
+"""[thrusters] valve_model: on_off (bench.valves.valve) or throttled (bench.valves.throttled)."""
+EVENT_KINDS = ("capture",)
+"""[[events]] kinds: capture (bench.dynamics.capture)."""
+MAX_THRUSTERS = 16
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
@@ -50,6 +60,8 @@ class MassSpec:
 class ThrusterSpec:
     r_thr_B_m: Vec3
     d_thr_B: Vec3
+    max_thrust_N: float | None = None
+    """This thruster's maximum thrust [N]; None = the valve's ``max_thrust_N``."""
 
 
 @dataclass(frozen=True)
@@ -61,6 +73,42 @@ class ValveSpec:
     rise_tau_s: float
     tail_tau_s: float
     min_on_s: float
+    model: str = "on_off"
+
+
+@dataclass(frozen=True)
+class DynamicsSpec:
+    """[dynamics]: translation model and the leader's circular orbit radius [m]."""
+
+    translation: str = "inertial"
+    orbit_radius_m: float = SEED000_ORBIT_RADIUS_M
+
+
+@dataclass(frozen=True)
+class EnvironmentSpec:
+    """[environment]: gravity-gradient torque on/off about a circular orbit of radius [m]."""
+
+    gravity_gradient: bool = False
+    orbit_radius_m: float = SEED000_ORBIT_RADIUS_M
+
+
+@dataclass(frozen=True)
+class CaptureSpec:
+    """A [[events]] capture: new mass [kg], inertia about the new CoM [kg m^2], CoM [m]."""
+
+    t_s: float
+    mass: MassSpec
+    com_B_m: Vec3
+
+    def record(self) -> dict[str, Any]:
+        """The event as logged (events.jsonl, summary.json)."""
+        return {
+            "kind": "capture",
+            "t_s": self.t_s,
+            "mass_kg": self.mass.mass_kg,
+            "inertia_B_kgm2": [list(r) for r in self.mass.inertia_B_kgm2],
+            "com_B_m": list(self.com_B_m),
+        }
 
 
 @dataclass(frozen=True)
@@ -110,6 +158,8 @@ class Expectations:
     steady_state_window_s: float
     steady_state_position_error_m_max: float | None = None
     final_position_error_m_max: float | None = None
+    position_band_m: float | None = None
+    position_settling_time_s_max: float | None = None
 
 
 @dataclass(frozen=True)
@@ -141,26 +191,68 @@ class Scenario:
     expectations: Expectations
     raw: dict[str, Any] = field(repr=False, compare=False, default_factory=dict)
     overrides: tuple[str, ...] = ()
+    dynamics: DynamicsSpec = DynamicsSpec()
+    environment: EnvironmentSpec = EnvironmentSpec()
+    disturbance: DisturbanceParams | None = None
+    events: tuple[CaptureSpec, ...] = ()
+    reference: ReferenceParams = field(default_factory=ReferenceParams)
+    r_target_N_m: Vec3 | None = None
+    """[manoeuvre] r_target_N_m: reference position of the position metrics (None = r0)."""
+
+    @property
+    def max_thrusts_N(self) -> tuple[float, ...]:
+        """Maximum thrust of every thruster [N] (its own, else the valve's)."""
+        v = self.valve.max_thrust_N
+        return tuple(v if t.max_thrust_N is None else t.max_thrust_N for t in self.thrusters)
+
+    @property
+    def r_reference_N_m(self) -> Vec3:
+        """Reference position of the position metrics [m] (target, else the initial one)."""
+        return self.r0_N_m if self.r_target_N_m is None else self.r_target_N_m
 
     def fsw_config(self) -> dict[str, Any]:
-        """The flight-software configuration file content (nominal vehicle + [flight_sw])."""
-        return {
+        """The flight-software configuration file content (nominal vehicle + [flight_sw]).
+
+        New keys appear only when the scenario uses the feature, so the configuration of
+        a scenario without them is unchanged: per-thruster ``max_thrust_N`` (when the
+        thrusters' maxima differ from the valve's; the top-level one is their maximum),
+        ``valve_model`` (when throttled; ``min_on_s`` is then 0), and in ``manoeuvre``
+        ``kind`` + ``mrp_coefficients`` (MRP polynomial; ``q_target_BN`` is then the
+        reference at the end of the run) and ``r_target_N_m`` (when given).
+        """
+        maxima = self.max_thrusts_N
+        per_thruster = any(m != self.valve.max_thrust_N for m in maxima)
+        thrusters: list[dict[str, Any]] = []
+        for t, m in zip(self.thrusters, maxima, strict=True):
+            entry: dict[str, Any] = {"r_thr_B_m": list(t.r_thr_B_m), "d_thr_B": list(t.d_thr_B)}
+            if per_thruster:
+                entry["max_thrust_N"] = m
+            thrusters.append(entry)
+        throttled = self.valve.model != "on_off"
+        manoeuvre: dict[str, Any] = {
+            "q_target_BN": list(self.q_target_BN),
+            "t_start_s": self.manoeuvre_start_s,
+        }
+        if self.reference.kind != KIND_STEP:
+            manoeuvre["kind"] = self.reference.kind
+            manoeuvre["mrp_coefficients"] = [list(c) for c in self.reference.mrp_coefficients]
+        if self.r_target_N_m is not None:
+            manoeuvre["r_target_N_m"] = list(self.r_target_N_m)
+        cfg: dict[str, Any] = {
             "source": self.path,
             "vehicle": {
                 "mass_kg": self.nominal.mass_kg,
                 "inertia_B_kgm2": [list(r) for r in self.nominal.inertia_B_kgm2],
             },
-            "thrusters": [
-                {"r_thr_B_m": list(t.r_thr_B_m), "d_thr_B": list(t.d_thr_B)} for t in self.thrusters
-            ],
-            "max_thrust_N": self.valve.max_thrust_N,
-            "min_on_s": self.valve.min_on_s,
-            "manoeuvre": {
-                "q_target_BN": list(self.q_target_BN),
-                "t_start_s": self.manoeuvre_start_s,
-            },
+            "thrusters": thrusters,
+            "max_thrust_N": max(maxima),
+            "min_on_s": 0.0 if throttled else self.valve.min_on_s,
+            "manoeuvre": manoeuvre,
             "flight_sw": self.flight_sw,
         }
+        if throttled:
+            cfg["valve_model"] = self.valve.model
+        return cfg
 
 
 def quat_from_euler_zyx(yaw_rad: float, pitch_rad: float, roll_rad: float) -> Quat:
@@ -220,14 +312,35 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
             raise t.error("list", [], "at least one [[thrusters.list]] entry (or a layout)")
         geo = []
         for it in items:
-            geo.append(ThrusterSpec(it.vector("r_thr_B_m", 3), _unit(it, "d_thr_B", 3)))  # type: ignore[arg-type]
+            geo.append(
+                ThrusterSpec(
+                    it.vector("r_thr_B_m", 3),  # type: ignore[arg-type]
+                    _unit(it, "d_thr_B", 3),  # type: ignore[arg-type]
+                    it.number("max_thrust_N", lo=0.0, lo_open=True)
+                    if it.has("max_thrust_N") else None,
+                )
+            )
             it.done()
     else:
         arm = t.number("arm_R_m", lo=0.0, lo_open=True)
         length = t.number("length_L_m", lo=0.0, lo_open=True)
         geo = [ThrusterSpec(r, d) for r, d in LAYOUTS[layout](arm, length)]
-    if len(geo) > 16:
+        default_max = LAYOUT_MAX_THRUST_N.get(layout)
+        if default_max is not None:
+            geo = [
+                dataclasses.replace(g, max_thrust_N=m)
+                for g, m in zip(geo, default_max, strict=True)
+            ]
+    if len(geo) > MAX_THRUSTERS:
         raise t.error("list", len(geo), "at most 16 thrusters (THR_CMD_0..3 carry 16)")
+    if t.has("max_thrust_per_thruster_N"):
+        if layout == "explicit":
+            raise t.error("max_thrust_per_thruster_N", t.raw("max_thrust_per_thruster_N"),
+                          "absent with an explicit list (give max_thrust_N per entry)")
+        maxima = t.vector("max_thrust_per_thruster_N", len(geo))
+        if min(maxima) <= 0.0:
+            raise t.error("max_thrust_per_thruster_N", list(maxima), "numbers > 0")
+        geo = [dataclasses.replace(g, max_thrust_N=m) for g, m in zip(geo, maxima, strict=True)]
     v = ValveSpec(
         max_thrust_N=t.number("max_thrust_N", lo=0.0, lo_open=True),
         isp_s=t.number("isp_s", lo=0.0, lo_open=True),
@@ -236,6 +349,7 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
         rise_tau_s=t.number("rise_tau_s", lo=0.0, lo_open=True, hi=1.0),
         tail_tau_s=t.number("tail_tau_s", lo=0.0, lo_open=True, hi=1.0),
         min_on_s=t.number("min_on_s", lo=0.0, hi=0.1),
+        model=t.string("valve_model", "on_off", choices=VALVE_MODELS),
     )
     t.done()
     return tuple(geo), v
@@ -282,6 +396,95 @@ def _opt(t: Table, key: str) -> float | None:
     return t.number(key, lo=0.0) if t.has(key) else None
 
 
+def _bool(t: Table, key: str, default: bool) -> bool:
+    v = t.raw(key, default)
+    if not isinstance(v, bool):
+        raise t.error(key, v, "true or false")
+    return v
+
+
+def _dynamics_environment(root: Table) -> tuple[DynamicsSpec, EnvironmentSpec]:
+    dt = root.table("dynamics", {})
+    dyn = DynamicsSpec(
+        translation=dt.string("translation", "inertial", choices=TRANSLATIONS),
+        orbit_radius_m=dt.number("orbit_radius_m", SEED000_ORBIT_RADIUS_M, lo=0.0, lo_open=True),
+    )
+    dt.done()
+    et = root.table("environment", {})
+    env = EnvironmentSpec(
+        gravity_gradient=_bool(et, "gravity_gradient", False),
+        orbit_radius_m=et.number("orbit_radius_m", dyn.orbit_radius_m, lo=0.0, lo_open=True),
+    )
+    if dyn.translation == "hcw" and env.orbit_radius_m != dyn.orbit_radius_m:
+        raise et.error("orbit_radius_m", env.orbit_radius_m,
+                       f"the HCW orbit's radius dynamics.orbit_radius_m = {dyn.orbit_radius_m}"
+                       " (one orbit)")
+    et.done()
+    return dyn, env
+
+
+def _sinusoid(t: Table, amplitude_key: str) -> Sinusoid:
+    s = Sinusoid(
+        t.vector3(amplitude_key),
+        t.number("omega_rad_s"),
+        t.number("phase_rad", 0.0),
+        source=f"{t.source}: {t.path}",
+    )
+    t.done()
+    return s
+
+
+def _disturbance(root: Table) -> DisturbanceParams | None:
+    if not root.has("disturbance"):
+        return None
+    t = root.table("disturbance")
+    p = DisturbanceParams(
+        force_N=t.vector3("force_N", [0.0, 0.0, 0.0]),
+        force_sinusoids=tuple(_sinusoid(x, "amplitude_N") for x in t.tables("force_sinusoids")),
+        torque_Nm=t.vector3("torque_Nm", [0.0, 0.0, 0.0]),
+        torque_sinusoids=tuple(
+            _sinusoid(x, "amplitude_Nm") for x in t.tables("torque_sinusoids")
+        ),
+        force_frame=t.string("force_frame", "body", choices=FORCE_FRAMES),
+        source=f"{t.source}: {t.path}",
+    )
+    t.done()
+    return p
+
+
+def _events(root: Table, duration_s: float) -> tuple[CaptureSpec, ...]:
+    out = []
+    for t in root.tables("events"):
+        t.string("kind", choices=EVENT_KINDS)
+        out.append(
+            CaptureSpec(
+                t_s=t.number("t_s", lo=0.0, hi=duration_s),
+                mass=_mass(t),
+                com_B_m=t.vector3("com_B_m", [0.0, 0.0, 0.0]),
+            )
+        )
+        t.done()
+    return tuple(sorted(out, key=lambda e: e.t_s))
+
+
+def _mrp_coefficients(t: Table) -> tuple[tuple[float, ...], ...]:
+    v = t.raw("mrp_coefficients")
+    expected = "3 lists (x, y, z) of polynomial coefficients, highest power first"
+    if not isinstance(v, list) or len(v) != 3:
+        raise t.error("mrp_coefficients", v, expected)
+    for i, c in enumerate(v):
+        if (
+            not isinstance(c, list)
+            or not c
+            or not all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                for x in c
+            )
+        ):
+            raise t.error(f"mrp_coefficients[{i}]", c, "a non-empty list of finite numbers")
+    return tuple(tuple(float(x) for x in c) for c in v)
+
+
 def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     """Validate parsed TOML ``data`` from file ``source`` into a :class:`Scenario`."""
     root = Table(data, source)
@@ -319,13 +522,24 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     it.done()
 
     mt = root.table("manoeuvre")
-    if mt.has("target_q_BN"):
-        q_target = _quat(mt, "target_q_BN")
-    else:
-        yaw, pitch, roll = (x * DEG_RAD for x in mt.vector("target_euler_zyx_deg", 3))
-        q_target = quat_from_euler_zyx(yaw, pitch, roll)
+    kind = mt.string("kind", KIND_STEP, choices=KINDS)
     t_start = mt.number("t_start_s", 0.0, lo=0.0, hi=duration_s)
+    if kind != KIND_STEP:
+        ref = ReferenceParams(kind, mrp_coefficients=_mrp_coefficients(mt), t_start_s=t_start,
+                              source=f"{source}: manoeuvre")
+        q_target = reference(ref, duration_s)[0]
+    else:
+        if mt.has("target_q_BN"):
+            q_target = _quat(mt, "target_q_BN")
+        else:
+            yaw, pitch, roll = (x * DEG_RAD for x in mt.vector("target_euler_zyx_deg", 3))
+            q_target = quat_from_euler_zyx(yaw, pitch, roll)
+        ref = ReferenceParams(kind, q_target, t_start_s=t_start, source=f"{source}: manoeuvre")
+    r_target = mt.vector3("r_target_N_m") if mt.has("r_target_N_m") else None
     mt.done()
+    dynamics, environment = _dynamics_environment(root)
+    disturbance = _disturbance(root)
+    events = _events(root, duration_s)
 
     fsw = root.raw("flight_sw", {})
     if not isinstance(fsw, dict):
@@ -345,6 +559,9 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         steady_state_rate_error_deg_s_max=_opt(et, "steady_state_rate_error_deg_s_max"),
         steady_state_position_error_m_max=_opt(et, "steady_state_position_error_m_max"),
         final_position_error_m_max=_opt(et, "final_position_error_m_max"),
+        position_band_m=et.number("position_band_m", lo=0.0, lo_open=True)
+        if et.has("position_band_m") else None,
+        position_settling_time_s_max=_opt(et, "position_settling_time_s_max"),
         steady_state_window_s=et.number(
             "steady_state_window_s", 10.0, lo=0.0, lo_open=True, hi=duration_s
         ),
@@ -376,6 +593,12 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         faults=faults,
         expectations=exp,
         raw=data,
+        dynamics=dynamics,
+        environment=environment,
+        disturbance=disturbance,
+        events=events,
+        reference=ref,
+        r_target_N_m=r_target,
     )
 
 

@@ -23,6 +23,7 @@ Optional tables of ``flight_sw`` (issue 4):
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from collections.abc import Callable
@@ -37,12 +38,14 @@ from flight_sw.allocation.base import Allocator
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
 from flight_sw.computer import DEFAULT_NAV_TIMEOUT_NS, FlightComputer, Timeline
-from flight_sw.control.base import AttitudeController, TranslationController
+from flight_sw.control.base import AttitudeController, PoseController, TranslationController
 from flight_sw.control.cascade_lqr import CascadeLqr, CascadeLqrDesign, CascadeLqrParams
 from flight_sw.control.mrp_direct_parametric import MrpDirectParametric, MrpDirectParametricParams
+from flight_sw.control.nftsm_dq import NftsmDq, NftsmDqParams
 from flight_sw.control.position_pd import PositionPd, PositionPdParams
 from flight_sw.control.quaternion_pd import QuaternionPd, QuaternionPdParams
 from flight_sw.control.quaternion_pid import QuaternionPid, QuaternionPidParams
+from flight_sw.control.tsm_dq import TsmDq, TsmDqParams
 from flight_sw.estimation.base import AttitudeEstimator, InertiaIdentifier
 from flight_sw.estimation.mekf import Mekf, MekfParams
 from flight_sw.estimation.rls_inertia import RlsInertiaIdentifier, RlsInertiaParams
@@ -53,7 +56,7 @@ from flight_sw.fdir.sensor_watchdog import LOST_AFTER_PERIODS, SensorWatchdog
 from flight_sw.fdir.thruster_fdir import ThrusterFdir
 from flight_sw.fdir.valve_status import ValveStatusFdir, ValveStatusParams
 from flight_sw.guidance.base import AttitudeGuidance
-from flight_sw.guidance.mrp_polynomial import SEED001_SIGMA_COEFFS, MrpPolynomialGuidance
+from flight_sw.guidance.mrp_polynomial import MrpPolynomialGuidance
 from flight_sw.modulation.base import Modulator
 from flight_sw.modulation.proportional import ProportionalModulator
 from flight_sw.modulation.pwpf import PwpfModulator, PwpfParams
@@ -66,6 +69,22 @@ SQRT_HOUR_S = 60.0
 NS_PER_S = 1_000_000_000
 TORQUE_ROWS = slice(3, 6)
 WRENCH_ROWS = slice(0, 6)
+
+
+class _NoAttitudeLaw:
+    """Stands in for the attitude law when a coupled 6-DoF law commands the torque."""
+
+    def torque_B_Nm(
+        self,
+        t_ns: int,
+        q_BN: np.ndarray,
+        omega_BN_B: np.ndarray,
+        q_RN: np.ndarray,
+        omega_RN_B: np.ndarray,
+        domega_RN_B: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Never called while the pose law is set (see FlightComputer.cycle)."""
+        raise RuntimeError("the coupled 6-DoF law commands the torque")
 
 
 class Vehicle:
@@ -214,6 +233,41 @@ def _mrp_direct_parametric(t: Table, v: Vehicle) -> AttitudeController:
     return MrpDirectParametric(params, v.inertia_B_kgm2)
 
 
+def _dataclass_params(t: Table, cls: Any, defaults: dict[str, Any]) -> Any:
+    """``cls`` built from the table: every field optional, read by its default's type."""
+    kwargs: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        default = defaults.get(f.name, f.default)
+        if not t.has(f.name):
+            kwargs[f.name] = default
+        elif isinstance(default, bool):
+            value = t.raw(f.name)
+            if not isinstance(value, bool):
+                raise t.error(f.name, value, "true or false")
+            kwargs[f.name] = value
+        elif isinstance(default, tuple):
+            kwargs[f.name] = t.vector3(f.name)
+        else:
+            kwargs[f.name] = t.number(f.name)
+    return cls(**kwargs)
+
+
+def _nominal_mass(v: Vehicle) -> dict[str, Any]:
+    j = v.inertia_B_kgm2
+    return {
+        "mass_kg": v.mass_kg,
+        "inertia_B_kgm2": (float(j[0, 0]), float(j[1, 1]), float(j[2, 2])),
+    }
+
+
+def _nftsm_dq(t: Table, v: Vehicle) -> PoseController:
+    return NftsmDq(_dataclass_params(t, NftsmDqParams, _nominal_mass(v)))
+
+
+def _tsm_dq(t: Table, v: Vehicle) -> PoseController:
+    return TsmDq(_dataclass_params(t, TsmDqParams, _nominal_mass(v)))
+
+
 def _pseudo_inverse(t: Table, v: Vehicle) -> Allocator:
     b = v.effectiveness[v.demand_rows]
     return PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_N=v.max_thrust_N))
@@ -351,7 +405,8 @@ def _rls(t: Table, v: Vehicle) -> InertiaIdentifier:
 
 
 def _mrp_polynomial(t: Table, v: Vehicle) -> AttitudeGuidance:
-    coeffs = t.raw("sigma_coeffs", [list(c) for c in SEED001_SIGMA_COEFFS])
+    """Seed 001 §5: ``mrp_coefficients`` per axis, highest power first, τ = t − t_start_s."""
+    coeffs = t.raw("mrp_coefficients")
     ok = (
         isinstance(coeffs, list)
         and len(coeffs) == 3
@@ -363,15 +418,15 @@ def _mrp_polynomial(t: Table, v: Vehicle) -> AttitudeGuidance:
         )
     )
     if not ok:
-        raise t.error("sigma_coeffs", coeffs, "3 lists of numbers (ascending powers of t)")
+        raise t.error("mrp_coefficients", coeffs, "3 lists of numbers (highest power first)")
     try:
         return MrpPolynomialGuidance(
-            sigma_coeffs=tuple(tuple(float(x) for x in c) for c in coeffs),
+            sigma_coeffs=tuple(tuple(float(x) for x in reversed(c)) for c in coeffs),
             t0_ns=round(t.number("t_start_s", 0.0, lo=0.0) * NS_PER_S),
-            duration_s=t.number("duration_s", 100.0, lo=0.0, lo_open=True),
+            duration_s=math.inf,  # the bench's reference does not stop either
         )
     except ValueError as exc:
-        raise t.error("sigma_coeffs", coeffs, str(exc)) from exc
+        raise t.error("mrp_coefficients", coeffs, str(exc)) from exc
 
 
 ESTIMATORS: dict[str, Callable[[Table, Vehicle], AttitudeEstimator]] = {"mekf": _mekf}
@@ -380,6 +435,11 @@ CONTROLLERS: dict[str, Callable[[Table, Vehicle], AttitudeController]] = {
     "quaternion_pid": _quaternion_pid,
     "cascade_lqr": _cascade_lqr,
     "mrp_direct_parametric": _mrp_direct_parametric,
+}
+# Coupled 6-DoF laws (force and torque together), chosen by [flight_sw.controller] kind too.
+POSE_CONTROLLERS: dict[str, Callable[[Table, Vehicle], PoseController]] = {
+    "nftsm_dq": _nftsm_dq,
+    "tsm_dq": _tsm_dq,
 }
 ALLOCATORS: dict[str, Callable[[Table, Vehicle], Allocator]] = {"pseudo_inverse": _pseudo_inverse}
 MODULATORS: dict[str, Callable[[Table, Vehicle], Callable[[], Modulator]]] = {
@@ -463,25 +523,37 @@ def build_computer(
     root = Table(cfg, source)
     root.raw("source", "")
     vehicle = Vehicle(root.table("vehicle"), root)
+    root.string("valve_model", "on_off", choices=("on_off", "throttled"))  # the bench's
     man = root.table("manoeuvre")
     kind = man.string("kind", "step", choices=("step", *GUIDANCE))
-    guidance: AttitudeGuidance | None = None
-    if kind == "step":
-        q_target = np.array(man.vector("q_target_BN", 4))
-        if abs(float(np.linalg.norm(q_target)) - 1.0) > 1e-6:
-            raise man.error("q_target_BN", q_target.tolist(), "a unit quaternion")
-        t_start_ns = round(man.number("t_start_s", lo=0.0) * NS_PER_S)
-        man.done()
-    else:
-        man.raw("kind")
-        guidance = _build(man, GUIDANCE[kind], vehicle)  # checks every key of the table
-        q_target, t_start_ns = guidance.reference(0).q_RN.copy(), 0
+    q_target = np.array(man.vector("q_target_BN", 4))
+    if abs(float(np.linalg.norm(q_target)) - 1.0) > 1e-6:
+        raise man.error("q_target_BN", q_target.tolist(), "a unit quaternion")
+    t_start_ns = round(man.number("t_start_s", lo=0.0) * NS_PER_S)
+    r_target_man = np.array(man.vector3("r_target_N_m")) if man.has("r_target_N_m") else None
+    # a moving reference (else the Timeline's step: hold, then q_target)
+    guidance = None if kind == "step" else _build(man, GUIDANCE[kind], vehicle)
+    man.done()
     vehicle.control_period_ns = control_period_ns
     vehicle.imu_period_ns = imu_period_ns
     fsw = root.table("flight_sw", {})
     est_table = fsw.raw("estimator", None)
     estimator = _strategy(fsw, "estimator", ESTIMATORS, vehicle)
-    controller = _strategy(fsw, "controller", CONTROLLERS, vehicle)
+    ctl = fsw.table("controller")
+    pose: PoseController | None = None
+    if ctl.string("kind", choices=(*CONTROLLERS, *POSE_CONTROLLERS)) in POSE_CONTROLLERS:
+        pose = _strategy(fsw, "controller", POSE_CONTROLLERS, vehicle)
+        controller: AttitudeController = _NoAttitudeLaw()
+        vehicle.demand_rows = WRENCH_ROWS
+        if fsw.has("translation"):
+            raise fsw.error(
+                "translation",
+                fsw.raw("translation"),
+                "no translation table: the 6-DoF "
+                f"controller {ctl.raw('kind')!r} commands force and torque together",
+            )
+    else:
+        controller = _strategy(fsw, "controller", CONTROLLERS, vehicle)
     translation, r_target = None, None
     if fsw.has("translation"):
         translation, r_target = _strategy(fsw, "translation", TRANSLATION_CONTROLLERS, vehicle)
@@ -519,7 +591,7 @@ def build_computer(
         max_thrust_N=vehicle.max_thrust_each_N,
         control_period_ns=control_period_ns,
         imu_period_ns=imu_period_ns,
-        timeline=Timeline(q_target, t_start_ns, r_target),
+        timeline=Timeline(q_target, t_start_ns, r_target if r_target is not None else r_target_man),
         watchdog=SensorWatchdog(
             {k: p for k, p in watch_periods_ns.items() if k in ("IMU_RATE", "STR_QUAT")}
         ),
@@ -533,6 +605,7 @@ def build_computer(
         nav_timeout_ns=(LOST_AFTER_PERIODS * nav_period if nav_period else DEFAULT_NAV_TIMEOUT_NS),
         guidance=guidance,
         inertia_id=inertia_id,
+        pose=pose,
     )
 
 

@@ -11,7 +11,8 @@ State (a plain tuple of 13 floats, hot path friendly; see the ``IDX_*`` constant
     - ``omega_BN_B`` angular velocity of B relative to N, in body axes [rad/s]
     - ``r_N``        position of the centre of mass in the inertial frame N [m]
     - ``v_N``        velocity of the centre of mass in N [m/s]
-    (Hill/HCW relative translation is a later addition; here translation is inertial.)
+    (Translation is inertial here; HCW relative translation in a Hill frame and
+    environment wrenches are in ``bench.dynamics.hcw`` and ``bench.dynamics.stepper``.)
 
 Frames and quaternion convention
     N is inertial, B is body-fixed with its origin at the centre of mass. Quaternions

@@ -30,11 +30,32 @@ trim. The 16 wrench columns positively span all six degrees of freedom (a strict
 positive null vector of the 6×16 effectiveness matrix exists), and still do with any
 single thruster removed (checked in tests/flight_sw/test_fsw_layouts.py), which is what
 single-failure reconfiguration needs.
+
+``seed001_table1_16`` — the 8 thrusters of seed 001 (MRP direct-parametric control with
+robust least-squares control allocation of a combined spacecraft), §5 Table 1, as 16
+unidirectional valves. Table 1 gives positions (arm R = 0.75 m, offset L = 0.75 m:
+thrusters 1-4 at (0, -L, R), (-R, -L, 0), (0, -L, -R), (R, -L, 0); 5-8 at
+(±R/√2, -L, ±R/√2), i.e. 0.375√2 = R/√2) and orientations as direction angles
+(α, β, γ) to x, y, z, so d = (cos α, cos β, cos γ): 1 -z, 2 +x, 3 +z, 4 -x, 5 -x, 6 +x,
+7 +x, 8 -x. The paper's actuators are bidirectional with signed bounds
+-2.3 N ≤ u_i ≤ 2.35 N (§5 item 4). Mapping: a negative bound is an opposing thruster,
+so actuator i (0-based) is the pair of valves i (along d_i, max 2.35 N) and i + 8 (along
+-d_i, same position, max 2.3 N); u_i = F_i - F_{i+8}. A bidirectional actuator (e.g. a
+cold-gas valve pair) is exactly that pair. ``seed001_table1_max_thrust_N`` gives the
+per-valve maxima in that order (the scenario's default for this layout).
 """
 
 from __future__ import annotations
 
+import math
+
 Vec3 = tuple[float, float, float]
+
+SEED001_UPPER_BOUND_N = 2.35
+"""Seed 001 §5: upper bound ū of each actuator's force [N] (valve i)."""
+SEED001_LOWER_BOUND_N = 2.3
+"""Seed 001 §5: magnitude of the lower bound -2.3 N [N] (the opposing valve i + 8)."""
+SEED001_ACTUATORS = 8
 
 
 def seed003_cascade_8(arm_R_m: float, length_L_m: float) -> tuple[tuple[Vec3, Vec3], ...]:
@@ -74,7 +95,40 @@ def seed000_conventional_16(arm_R_m: float, length_L_m: float) -> tuple[tuple[Ve
     return tuple(out)
 
 
+def seed001_table1_16(arm_R_m: float, length_L_m: float) -> tuple[tuple[Vec3, Vec3], ...]:
+    """Geometry of seed 001's Table 1 as 16 valves (see module docstring; R = L = 0.75 m)."""
+    R, L = arm_R_m, length_L_m
+    a = R / math.sqrt(2.0)
+    table1: tuple[tuple[Vec3, Vec3], ...] = (
+        ((0.0, -L, R), (0.0, 0.0, -1.0)),
+        ((-R, -L, 0.0), (1.0, 0.0, 0.0)),
+        ((0.0, -L, -R), (0.0, 0.0, 1.0)),
+        ((R, -L, 0.0), (-1.0, 0.0, 0.0)),
+        ((a, -L, a), (-1.0, 0.0, 0.0)),
+        ((-a, -L, a), (1.0, 0.0, 0.0)),
+        ((-a, -L, -a), (1.0, 0.0, 0.0)),
+        ((a, -L, -a), (-1.0, 0.0, 0.0)),
+    )
+    opposing = tuple(
+        (r, (-d[0] or 0.0, -d[1] or 0.0, -d[2] or 0.0)) for r, d in table1
+    )  # `or 0.0`: no negative zeros
+    return table1 + opposing
+
+
+def seed001_table1_max_thrust_N(
+    upper_N: float = SEED001_UPPER_BOUND_N, lower_N: float = SEED001_LOWER_BOUND_N
+) -> tuple[float, ...]:
+    """Per-valve maximum thrust of ``seed001_table1_16``: 8 × ``upper_N``, 8 × ``lower_N``."""
+    return (upper_N,) * SEED001_ACTUATORS + (lower_N,) * SEED001_ACTUATORS
+
+
 LAYOUTS = {
     "seed003_cascade_8": seed003_cascade_8,
     "seed000_conventional_16": seed000_conventional_16,
+    "seed001_table1_16": seed001_table1_16,
 }
+
+LAYOUT_MAX_THRUST_N = {
+    "seed001_table1_16": seed001_table1_max_thrust_N(),
+}
+"""Per-thruster maximum thrust [N] of layouts whose source gives one (scenario default)."""

@@ -55,12 +55,13 @@ Assumptions
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from bench.dynamics.rigid_body import Vec3, Wrench, quat_from_axis_angle, rotate_B_to_N
+from bench.valves.base import ValveModel
 from bench.valves.valve import FAULT_KINDS, S_PER_NS, FaultParams, Valve, ValveParams
 from dbc.errors import ConfigError
 
@@ -79,6 +80,9 @@ MAX_MISALIGNMENT_DEG = 180.0
 """|angle_deg| of a ``misaligned`` fault is at most this (any rotation is reachable)."""
 CHILD_SEED_BOUND = 2**63 - 1
 """Exclusive upper bound of the per-valve seeds drawn from the constructor's ``rng``."""
+
+ValveFactory = Callable[[ValveParams, "np.random.Generator | None"], ValveModel]
+"""Builds one valve model from its parameters and generator (default: the on-off ``Valve``)."""
 
 ThrusterStatus = tuple[bool, bool, bool]
 """(coil_energised, open, current) of one valve, as ``Valve.status``."""
@@ -131,9 +135,13 @@ class ThrusterSet:
     ``params`` is one ``ValveParams`` shared by all thrusters or a sequence of one per
     thruster. ``g0_m_s2`` is the Isp reference gravity (standard gravity by default).
     ``rng`` (optional) seeds each valve's generator for ``intermittent`` drop-outs.
+    ``valve_factory`` (optional) builds each valve model (default ``Valve``, the on-off
+    valve; e.g. ``bench.valves.throttled.ThrottledValve`` with its period bound).
     """
 
     __slots__ = (
+        "_com_B_m",
+        "_geometries_ref",
         "_impulse_Ns",
         "_misalignment",
         "_rows",
@@ -151,6 +159,7 @@ class ThrusterSet:
         *,
         source: str = "ThrusterSet",
         rng: np.random.Generator | None = None,
+        valve_factory: ValveFactory | None = None,
     ) -> None:
         geoms = tuple(geometries)
         if not geoms or not all(isinstance(g, ThrusterGeometry) for g in geoms):
@@ -177,12 +186,19 @@ class ThrusterSet:
             raise ConfigError(source, "rng", rng, "None or a numpy Generator")
         self._source = source
         self.geometries = geoms
-        self.valves = tuple(Valve(p, r) for p, r in zip(plist, rngs, strict=True))
+        self._geometries_ref = geoms
+        self._com_B_m: Vec3 = (0.0, 0.0, 0.0)
+        make: ValveFactory = valve_factory if valve_factory is not None else Valve
+        self.valves: tuple[ValveModel, ...] = tuple(
+            make(p, r) for p, r in zip(plist, rngs, strict=True)
+        )
         self.g0_m_s2 = float(g0_m_s2)
         self._impulse_Ns = [0.0] * len(geoms)
         # Active misalignments: index → (recorded parameters, rotated geometry).
         self._misalignment: dict[int, tuple[FaultParams, ThrusterGeometry]] = {}
-        self._rows: tuple[tuple[int, Valve, float, float, float, float, float, float], ...] = ()
+        self._rows: tuple[
+            tuple[int, ValveModel, float, float, float, float, float, float], ...
+        ] = ()
         self._build_rows()
 
     def _build_rows(self) -> None:
@@ -194,6 +210,37 @@ class ThrusterSet:
 
     def __len__(self) -> int:
         return len(self.valves)
+
+    @property
+    def com_B_m(self) -> Vec3:
+        """Centre of mass the thruster positions are referred to, relative to the reference
+        point the geometries were given about (body axes) [m]."""
+        return self._com_B_m
+
+    def set_com_offset(self, com_B_m: Vec3) -> None:
+        """Refer every thruster position to a centre of mass at ``com_B_m`` [m, body axes].
+
+        ``com_B_m`` is relative to the point the constructor's geometries were given
+        about (not cumulative): r_i ← r_i,ref − com_B_m, so the torque arms r × d are
+        about the new centre of mass (a mass-property change, ``bench.dynamics.capture``).
+        Directions and active misalignments are kept. Applies to every wrench evaluated
+        after the call (call it at a step boundary).
+        """
+        c = _vec3(com_B_m, self._source, "com_B_m")
+        self._com_B_m = c
+        self.geometries = tuple(
+            ThrusterGeometry(
+                (g.r_thr_B_m[0] - c[0], g.r_thr_B_m[1] - c[1], g.r_thr_B_m[2] - c[2]),
+                g.d_thr_B,
+                source=g.source,
+            )
+            for g in self._geometries_ref
+        )
+        self._misalignment = {
+            i: (p, ThrusterGeometry(self.geometries[i].r_thr_B_m, g.d_thr_B, source=g.source))
+            for i, (p, g) in self._misalignment.items()
+        }
+        self._build_rows()
 
     # --- commands -------------------------------------------------------------------
     def command(self, t_ns: int, index: int, on_time_ns: int) -> None:

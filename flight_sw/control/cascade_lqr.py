@@ -19,7 +19,12 @@ sees ``x = [e, ė]``, ``ẋ = A x + B Δω_cmd`` with ``A = [[0, 1], [0, −k_i/
 ``AᵀP + PA − PBR⁻¹BᵀP + Q = 0`` give ``[k_p, k_d] = R⁻¹BᵀP``; in closed form
 ``k_p = √(q_angle/r)``, ``k_d = √(1 + q_rate/r + 2 k_p J_i/k_i) − 1``.
 
-Rate limit (optional ``max_rate_rad_s``): the rate command offset is clipped per axis.
+Rate limit (optional ``max_rate_rad_s``, Wie & Lu 1995 as in :mod:`.quaternion_pd`): the
+proportional term's error is clipped per axis at ``L_i = (1 + k_d,i) ω_max / k_p,i``
+(:func:`flight_sw.control.base.error_limit`), so far from the target the inner loop's
+equilibrium ``(1 + k_d) ω_e = −k_p L`` is a slew at ``ω_max``. Clipping the whole command
+offset instead would cap the braking torque at ``k_i (ω_max + |ω|)``, a few N m with
+Table 1's ``k_i`` — too little to stop a 72 kg m² axis in time.
 
 Inputs/outputs: see :class:`flight_sw.control.base.AttitudeController`; torque [N m];
 gain and weight units in :class:`CascadeLqrParams` and :class:`CascadeLqrDesign`.
@@ -47,6 +52,7 @@ import numpy as np
 from scipy.linalg import solve_continuous_are
 
 from dbc.errors import ConfigError
+from flight_sw.control.base import error_limit
 from flight_sw.quaternion import error_quaternion
 
 N_AXES = 3
@@ -121,7 +127,7 @@ class CascadeLqrParams:
         outer_kp_1_s: QPDLQR proportional gains (x, y, z) [1/s], each ≥ 0.
         outer_kd: QPDLQR derivative gains (x, y, z) [–], each ≥ 0.
         inner_kp_Nms: LPC rate gains (x, y, z) [N m s/rad], each > 0.
-        max_rate_rad_s: limit of the rate command offset per axis [rad/s] (inf: none).
+        max_rate_rad_s: slew rate the clipped proportional term settles at [rad/s] (inf: none).
     """
 
     outer_kp_1_s: Triple
@@ -155,7 +161,7 @@ class CascadeLqrDesign:
         q_angle: weight on the angle error [1/rad²], > 0.
         q_rate: weight on the rate error [s²/rad²], ≥ 0.
         r: weight on the rate command [s²/rad²], > 0.
-        max_rate_rad_s: limit of the rate command offset per axis [rad/s] (inf: none).
+        max_rate_rad_s: slew rate the clipped proportional term settles at [rad/s] (inf: none).
     """
 
     inner_kp_Nms: Triple
@@ -211,7 +217,7 @@ class CascadeLqr:
         self._kp = np.array(params.outer_kp_1_s)
         self._kd = np.array(params.outer_kd)
         self._ki = np.array(params.inner_kp_Nms)
-        self._max_rate = params.max_rate_rad_s
+        self._error_limit = error_limit(self._kp, 1.0 + self._kd, params.max_rate_rad_s)
 
     @property
     def params(self) -> CascadeLqrParams:
@@ -232,8 +238,8 @@ class CascadeLqr:
         angle_error = ANGLE_PER_QUATERNION_VECTOR * sign * dq[1:]
         omega_ref = np.asarray(omega_RN_B, dtype=float)
         rate_error = np.asarray(omega_BN_B, dtype=float) - omega_ref
-        offset = -self._kp * angle_error - self._kd * rate_error
-        return omega_ref + np.clip(offset, -self._max_rate, self._max_rate)
+        limited = np.clip(angle_error, -self._error_limit, self._error_limit)
+        return omega_ref - self._kp * limited - self._kd * rate_error
 
     def torque_B_Nm(
         self,

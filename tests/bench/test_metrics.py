@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bench.metrics import expectation, latency_summary, pointing_metrics
+from bench.metrics import expectation, latency_summary, pointing_metrics, settling_time_s
 
 BAND_DEG = 0.5
 WINDOW_S = 10.0
@@ -53,3 +53,12 @@ def test_short_run_steady_state_starts_at_settling() -> None:
     err = 30.0 * np.exp(-t / TAU_S)
     m = pointing_metrics(t, err, err, BAND_DEG, WINDOW_S)
     assert m.converged and m.steady_state_attitude_error_deg <= BAND_DEG
+
+
+def test_position_settling_time_known_answer() -> None:
+    """Error leaves the band last at t = 2 s: settled at the next sample, 3 s after a 0 s start."""
+    t = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
+    err = np.array([1.0, 0.01, 0.2, 0.01, 0.02])
+    assert settling_time_s(t, err, 0.05) == 3.0
+    assert settling_time_s(t, err, 0.05, t_start_s=1.0) == 2.0
+    assert settling_time_s(t, np.array([0.0, 0.0, 0.0, 0.0, 0.1]), 0.05) is None

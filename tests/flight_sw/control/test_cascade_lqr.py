@@ -75,15 +75,17 @@ def test_sign_of_quaternion_and_short_way() -> None:
     assert ctrl.torque_B_Nm(T_NS, q_270, ZERO, qt.identity(), ZERO)[0] > 0.0
 
 
-def test_rate_command_is_limited() -> None:
-    """With max_rate the command offset stays within ±max_rate per axis (large error)."""
+def test_rate_limit_sets_the_slew_rate() -> None:
+    """Far from the target, slewing at max_rate towards it needs no torque (the limit holds)."""
     max_rate = math.radians(2.0)
     ctrl = CascadeLqr(CascadeLqrParams.from_table1(max_rate_rad_s=max_rate))
     q_BN = qt.from_rotation_vector(np.radians([60.0, -40.0, 0.001]))
     w_ref = np.array([0.01, 0.0, 0.0])
-    cmd = ctrl.rate_command_B_rad_s(q_BN, ZERO, qt.identity(), w_ref)
-    np.testing.assert_allclose(np.abs(cmd - w_ref)[:2], max_rate, atol=EXACT_TOL)
-    assert abs(cmd[2] - w_ref[2]) < max_rate
+    slewing = w_ref + np.array([-max_rate, max_rate, 0.0])  # towards the target on x and y
+    tau = ctrl.torque_B_Nm(T_NS, q_BN, slewing, qt.identity(), w_ref)
+    np.testing.assert_allclose(tau[:2], 0.0, atol=EXACT_TOL)
+    faster = ctrl.torque_B_Nm(T_NS, q_BN, w_ref + 2.0 * (slewing - w_ref), qt.identity(), w_ref)
+    assert faster[0] > 0.0 and faster[1] < 0.0  # beyond the limit: braked
 
 
 def test_lqr_double_integrator_closed_form() -> None:

@@ -1,0 +1,1 @@
+"""External-wrench models of the vehicle: prescribed disturbances, gravity gradient."""

@@ -1,0 +1,155 @@
+"""Prescribed disturbance force and torque: a constant plus a sum of sinusoids.
+
+What it does
+    d(t) = c + Σ_k a_k sin(ω_k t + φ_k), per component, for the force [N] and the torque
+    [N·m] separately; t [s] is simulation time. Seed 000 §V uses exactly this form:
+    u_d = [0.06 + 0.03 sin(0.6t), 0.05 + 0.04 sin(0.9t), 0.04 + 0.01 sin(0.5t)] N and
+    τ_d = [2e-5 + 5e-4 sin(0.8t), 3e-5 + 3e-4 sin(0.5t), 1e-5 + 7e-4 sin(0.3t)] N·m.
+
+Frames
+    The torque is in body axes. The force is in body axes (``force_frame = "body"``) or in
+    the navigation frame of the translation state (``"nav"``: the inertial frame, or the
+    Hill frame with HCW translation), rotated into body axes with the attitude:
+    F_B = C(q_BN) C_IN(t) F_nav (``TranslationModel.nav_to_inertial``).
+
+Assumptions: the disturbance acts through the centre of mass (the torque is given
+separately) and does not depend on the state besides the attitude for ``"nav"`` forces.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from bench.dynamics.rigid_body import (
+    ZERO_VEC3,
+    MassProperties,
+    Quat,
+    Vec3,
+    Wrench,
+    rotate_N_to_B,
+)
+from bench.dynamics.translation import InertialTranslation, TranslationModel
+from dbc.errors import ConfigError
+
+FORCE_FRAMES = ("body", "nav")
+"""Frames a disturbance force may be given in (module docstring)."""
+VEC3_LEN = 3
+
+
+def _finite(v: object) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _vec3(value: object, source: str, key: str) -> Vec3:
+    if not isinstance(value, (tuple, list)):
+        raise ConfigError(source, key, value, "3 finite numbers")
+    seq = [x for x in value if _finite(x)]
+    if len(seq) != VEC3_LEN or len(value) != VEC3_LEN:
+        raise ConfigError(source, key, value, "3 finite numbers")
+    return (float(seq[0]), float(seq[1]), float(seq[2]))
+
+
+@dataclass(frozen=True)
+class Sinusoid:
+    """a sin(ω t + φ): amplitude 3-vector (unit of the quantity), ω [rad/s], φ [rad]."""
+
+    amplitude: Vec3
+    omega_rad_s: float
+    phase_rad: float = 0.0
+    source: str = field(default="Sinusoid", compare=False, repr=False, kw_only=True)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "amplitude", _vec3(self.amplitude, self.source, "amplitude"))
+        for key in ("omega_rad_s", "phase_rad"):
+            if not _finite(getattr(self, key)):
+                raise ConfigError(self.source, key, getattr(self, key), "a finite number")
+            object.__setattr__(self, key, float(getattr(self, key)))
+
+
+@dataclass(frozen=True)
+class DisturbanceParams:
+    """Constant force [N] / torque [N·m] plus sinusoids, and the force's frame."""
+
+    force_N: Vec3 = ZERO_VEC3
+    force_sinusoids: tuple[Sinusoid, ...] = ()
+    torque_Nm: Vec3 = ZERO_VEC3
+    torque_sinusoids: tuple[Sinusoid, ...] = ()
+    force_frame: str = "body"
+    source: str = field(default="DisturbanceParams", compare=False, repr=False, kw_only=True)
+
+    def __post_init__(self) -> None:
+        src = self.source
+        object.__setattr__(self, "force_N", _vec3(self.force_N, src, "force_N"))
+        object.__setattr__(self, "torque_Nm", _vec3(self.torque_Nm, src, "torque_Nm"))
+        for key in ("force_sinusoids", "torque_sinusoids"):
+            items = tuple(getattr(self, key))
+            if not all(isinstance(s, Sinusoid) for s in items):
+                raise ConfigError(src, key, getattr(self, key), "a sequence of Sinusoid")
+            object.__setattr__(self, key, items)
+        if self.force_frame not in FORCE_FRAMES:
+            raise ConfigError(src, "force_frame", self.force_frame, f"one of {FORCE_FRAMES}")
+
+    @property
+    def is_zero(self) -> bool:
+        """True if the disturbance is identically zero."""
+        zero = (0.0, 0.0, 0.0)
+        return (
+            self.force_N == zero
+            and self.torque_Nm == zero
+            and all(s.amplitude == zero for s in (*self.force_sinusoids, *self.torque_sinusoids))
+        )
+
+
+def sinusoid_sum(t_s: float, constant: Vec3, sinusoids: Sequence[Sinusoid]) -> Vec3:
+    """c + Σ a sin(ω t + φ) at ``t_s`` [s]."""
+    x, y, z = constant
+    for s in sinusoids:
+        k = math.sin(s.omega_rad_s * t_s + s.phase_rad)
+        x += s.amplitude[0] * k
+        y += s.amplitude[1] * k
+        z += s.amplitude[2] * k
+    return (x, y, z)
+
+
+def sinusoid_sum_integral(
+    t0_s: float, t1_s: float, constant: Vec3, sinusoids: Sequence[Sinusoid]
+) -> Vec3:
+    """∫_{t0}^{t1} (c + Σ a sin(ω t + φ)) dt, analytic (a ω = 0 term integrates as constant)."""
+    dt = t1_s - t0_s
+    out = [c * dt for c in constant]
+    for s in sinusoids:
+        w = s.omega_rad_s
+        if w == 0.0:
+            k = math.sin(s.phase_rad) * dt
+        else:
+            k = (math.cos(w * t0_s + s.phase_rad) - math.cos(w * t1_s + s.phase_rad)) / w
+        for i in range(VEC3_LEN):
+            out[i] += s.amplitude[i] * k
+    return (out[0], out[1], out[2])
+
+
+class Disturbance:
+    """``EnvironmentModel`` of a prescribed disturbance (module docstring)."""
+
+    def __init__(
+        self, params: DisturbanceParams, translation: TranslationModel | None = None
+    ) -> None:
+        self.params = params
+        self.translation: TranslationModel = translation or InertialTranslation()
+        self._nav = params.force_frame == "nav"
+
+    def force_nav_or_body_N(self, t_s: float) -> Vec3:
+        """The force as given, in its own frame (body or navigation) [N]."""
+        p = self.params
+        return sinusoid_sum(t_s, p.force_N, p.force_sinusoids)
+
+    def wrench_B(self, t_s: float, q_BN: Quat, mp: MassProperties) -> Wrench:
+        """Disturbance force [N] and torque [N·m] in body axes at ``t_s``."""
+        p = self.params
+        f = self.force_nav_or_body_N(t_s)
+        if self._nav:
+            f = rotate_N_to_B(q_BN, self.translation.nav_to_inertial(t_s, f))
+        tq = sinusoid_sum(t_s, p.torque_Nm, p.torque_sinusoids)
+        return (f[0], f[1], f[2], tq[0], tq[1], tq[2])
