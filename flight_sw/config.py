@@ -37,6 +37,10 @@ from dbc.schema import Table
 from flight_sw.allocation.base import Allocator
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
+from flight_sw.allocation.qp_osqp import BoundedQpAllocator, BoundedQpParams
+from flight_sw.allocation.robust_lft import RobustLftAllocator, RobustLftParams
+from flight_sw.allocation.robust_polyhedral import RobustPolyhedralAllocator
+from flight_sw.allocation.robust_polytopic import RobustParams, RobustPolytopicAllocator
 from flight_sw.computer import DEFAULT_NAV_TIMEOUT_NS, FlightComputer, Timeline
 from flight_sw.control.base import AttitudeController, PoseController, TranslationController
 from flight_sw.control.cascade_lqr import CascadeLqr, CascadeLqrDesign, CascadeLqrParams
@@ -269,8 +273,74 @@ def _tsm_dq(t: Table, v: Vehicle) -> PoseController:
 
 
 def _pseudo_inverse(t: Table, v: Vehicle) -> Allocator:
+    """Seeds 003/000 baseline; one bound for all (the smallest maximum thrust)."""
     b = v.effectiveness[v.demand_rows]
-    return PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_N=v.max_thrust_N))
+    tmax = float(np.min(v.max_thrust_each_N))
+    return PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_N=tmax))
+
+
+def _upper_N(v: Vehicle) -> tuple[float, ...]:
+    return tuple(float(x) for x in v.max_thrust_each_N)
+
+
+def _qp_osqp(t: Table, v: Vehicle) -> Allocator:
+    """Seed 000 eqs. 27-32: bounded least-shift allocation, an OSQP QP."""
+    d = BoundedQpParams(upper_N=1.0)
+    m = v.demand_rows.stop - v.demand_rows.start
+    weights = t.vector("demand_weights", m) if t.has("demand_weights") else None
+    params = BoundedQpParams(
+        upper_N=_upper_N(v),
+        regularization=t.number("regularization", d.regularization, lo=0.0, lo_open=True),
+        demand_weights=weights,
+    )
+    return BoundedQpAllocator(v.effectiveness[v.demand_rows], params)
+
+
+def _robust_params(t: Table, v: Vehicle) -> RobustParams:
+    d = RobustParams(upper_N=1.0)
+    weights = t.raw("basis_weights", list(d.basis_weights))
+    if not (
+        isinstance(weights, list)
+        and weights
+        and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in weights)
+    ):
+        raise t.error("basis_weights", weights, "a non-empty list of numbers")
+    return RobustParams(
+        upper_N=_upper_N(v),
+        rho=t.number("rho", d.rho, lo=0.0),
+        basis_weights=tuple(float(x) for x in weights),
+    )
+
+
+def _robust_polyhedral(t: Table, v: Vehicle) -> Allocator:
+    """Seed 001 Theorem 1: ΔB = Σ δ_i ρ w_i B, |δ_i| ≤ 1 (the §5 example by default)."""
+    return RobustPolyhedralAllocator(v.effectiveness[v.demand_rows], _robust_params(t, v))
+
+
+def _robust_polytopic(t: Table, v: Vehicle) -> Allocator:
+    """Seed 001 Theorem 2: ΔB in the convex hull of ±ρ w_i B."""
+    return RobustPolytopicAllocator(v.effectiveness[v.demand_rows], _robust_params(t, v))
+
+
+def _robust_lft(t: Table, v: Vehicle) -> Allocator:
+    """Seed 001 Theorem 3: ΔB = E F H, ‖F‖ ≤ 1 (E = ρ e_shape; H from the table or B)."""
+    d = RobustLftParams(upper_N=1.0)
+    m = v.demand_rows.stop - v.demand_rows.start
+    e_shape = _matrix(t, "e_shape", m, m) if t.has("e_shape") else None
+    h = t.raw("h_matrix", None)
+    h_matrix = None
+    if h is not None:
+        rows = len(h) if isinstance(h, list) else 0
+        h_matrix = _matrix(t, "h_matrix", rows, len(v.r_thr_B_m))
+    return RobustLftAllocator(
+        v.effectiveness[v.demand_rows],
+        RobustLftParams(
+            upper_N=_upper_N(v),
+            rho=t.number("rho", d.rho, lo=0.0),
+            e_shape=None if e_shape is None else tuple(tuple(map(float, r)) for r in e_shape),
+            h_matrix=None if h_matrix is None else tuple(tuple(map(float, r)) for r in h_matrix),
+        ),
+    )
 
 
 def _position_pd(t: Table, v: Vehicle) -> tuple[TranslationController, np.ndarray | None]:
@@ -441,7 +511,13 @@ POSE_CONTROLLERS: dict[str, Callable[[Table, Vehicle], PoseController]] = {
     "nftsm_dq": _nftsm_dq,
     "tsm_dq": _tsm_dq,
 }
-ALLOCATORS: dict[str, Callable[[Table, Vehicle], Allocator]] = {"pseudo_inverse": _pseudo_inverse}
+ALLOCATORS: dict[str, Callable[[Table, Vehicle], Allocator]] = {
+    "pseudo_inverse": _pseudo_inverse,
+    "qp_osqp": _qp_osqp,
+    "robust_polyhedral": _robust_polyhedral,
+    "robust_polytopic": _robust_polytopic,
+    "robust_lft": _robust_lft,
+}
 MODULATORS: dict[str, Callable[[Table, Vehicle], Callable[[], Modulator]]] = {
     "pwpf": _pwpf,
     "schmitt": _schmitt,
