@@ -440,6 +440,9 @@ class FlightNode:
             "mode": self.fc.mode.name,
             "cycle_time_us": _percentiles_us(self.stats.cycle_ns),
             "allocation": self._allocation_stats(),
+            "inertia_estimate_B_kgm2": (
+                None if self.fc.inertia_B_kgm2 is None else self.fc.inertia_B_kgm2.tolist()
+            ),
             "restarts": self.stats.restarts,
             "fdir": self._fdir_stats(),
         }
