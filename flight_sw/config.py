@@ -470,6 +470,7 @@ def _rls(t: Table, v: Vehicle) -> InertiaIdentifier:
             min_information=t.number("min_information", d.min_information, lo=0.0),
             min_regressor_norm=t.number("min_regressor_norm", d.min_regressor_norm, lo=0.0),
             max_gap_s=t.number("max_gap_s", d.max_gap_s, lo=0.0, lo_open=True),
+            window_cycles=t.integer("window_cycles", d.window_cycles, lo=1),
         )
     )
 

@@ -19,6 +19,12 @@ pulse shape inside the period). The gyroscopic integral is taken by the trapezoi
 equation ``y_k = Φ_k θ`` in torque units:
     ``Φ_k = Ω((ω_k − ω_{k−1})/h) + ½ ([ω_{k−1}×] Ω(ω_{k−1}) + [ω_k×] Ω(ω_k))``,  ``y_k = T̄_k``.
 
+Window (``window_cycles`` = N ≥ 1): the same equation integrated over the last N periods
+(``Φ = Ω((ω_k − ω_{k−N})/T) + (1/T) Σ_j ½([ω_{j−1}×]Ω(ω_{j−1}) + [ω_j×]Ω(ω_j)) h_j``,
+``y = (1/T) Σ_j T̄_j h_j``, ``T = Σ_j h_j``): rate noise on the differenced rates and the
+torque that valve delays carry from one period into the next both shrink by ~N, at the cost
+of a slower response (the windows overlap: one update per cycle).
+
 RLS update (seed 001 §2, the three equations after "the RLS algorithm to compute the
 updates for θ(t)", with ``Φ`` 3×6 so its ``P Φ`` reads ``P Φᵀ``):
     ``K_k = P_{k−1} Φ_kᵀ [λ I3 + Φ_k P_{k−1} Φ_kᵀ]⁻¹``,
@@ -129,6 +135,26 @@ def euler_regressor(omega_prev_B: np.ndarray, omega_B: np.ndarray, dt_s: float) 
     return momentum_regressor((w1 - w0) / dt_s) + TRAPEZOID_WEIGHT * gyro
 
 
+def _window_equation(
+    hist: list[tuple[int, np.ndarray, np.ndarray]],
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(Φ, y)`` of Euler's equation integrated over the samples of ``hist`` (docstring)."""
+    if len(hist) == 2:  # one period: the exact single-step form
+        (t0, w0, _), (t1, w1, tau1) = hist
+        return euler_regressor(w0, w1, (t1 - t0) / NS_PER_S), tau1
+    total_s = (hist[-1][0] - hist[0][0]) / NS_PER_S
+    gyro = np.zeros((N_AXES, N_PARAMS))
+    impulse = np.zeros(N_AXES)
+    for (ta, wa, _), (tb, wb, tau_b) in zip(hist[:-1], hist[1:], strict=True):
+        h = (tb - ta) / NS_PER_S
+        gyro += TRAPEZOID_WEIGHT * h * (
+            skew(wa) @ momentum_regressor(wa) + skew(wb) @ momentum_regressor(wb)
+        )
+        impulse += h * tau_b
+    phi = momentum_regressor((hist[-1][1] - hist[0][1]) / total_s) + gyro / total_s
+    return phi, impulse / total_s
+
+
 def _inertia_tuple(value: object) -> tuple[tuple[float, float, float], ...]:
     expected = "a symmetric positive-definite 3×3 matrix of finite numbers [kg m²]"
     try:
@@ -159,6 +185,7 @@ class RlsInertiaParams:
             [(rad/s²)²] (≥ 0; 0: as soon as the estimate is positive definite).
         min_regressor_norm: steps with ‖Φ‖_F below this are skipped [rad/s²] (≥ 0).
         max_gap_s: a gap between samples above this [s] (> 0) restarts the differencing.
+        window_cycles: periods the Euler equation is integrated over (≥ 1; module docstring).
     """
 
     inertia_guess_B_kgm2: Sequence[Sequence[float]] | np.ndarray
@@ -167,6 +194,7 @@ class RlsInertiaParams:
     min_information: float = DEFAULT_MIN_INFORMATION
     min_regressor_norm: float = DEFAULT_MIN_REGRESSOR_NORM
     max_gap_s: float = DEFAULT_MAX_GAP_S
+    window_cycles: int = 1
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia_guess_B_kgm2", _inertia_tuple(self.inertia_guess_B_kgm2))
@@ -184,6 +212,9 @@ class RlsInertiaParams:
                 raise ConfigError(_SOURCE, key, value, "a finite number >= 0")
         if _real("max_gap_s", self.max_gap_s, "a finite number > 0 [s]") <= 0.0:
             raise ConfigError(_SOURCE, "max_gap_s", self.max_gap_s, "a finite number > 0 [s]")
+        w = self.window_cycles
+        if isinstance(w, bool) or not isinstance(w, int) or w < 1:
+            raise ConfigError(_SOURCE, "window_cycles", w, "an integer >= 1")
 
 
 class RlsInertiaIdentifier:
@@ -194,7 +225,7 @@ class RlsInertiaIdentifier:
         self._theta = inertia_params(np.array(params.inertia_guess_B_kgm2))
         self._p = np.eye(N_PARAMS) * params.initial_covariance
         self._info = np.zeros((N_PARAMS, N_PARAMS))
-        self._prev: tuple[int, np.ndarray] | None = None
+        self._history: list[tuple[int, np.ndarray, np.ndarray]] = []  # (t_ns, ω, T̄ before t)
         self._n_updates = 0
 
     @property
@@ -235,7 +266,7 @@ class RlsInertiaIdentifier:
             self._theta = inertia_params(guess)
         self._p = np.eye(N_PARAMS) * self._params.initial_covariance
         self._info = np.zeros((N_PARAMS, N_PARAMS))
-        self._prev = None
+        self._history = []
         self._n_updates = 0
 
     def update(
@@ -250,19 +281,23 @@ class RlsInertiaIdentifier:
         w = np.array(omega_BN_B, dtype=float).reshape(N_AXES)
         tau = np.array(torque_B_Nm, dtype=float).reshape(N_AXES)
         if not (np.all(np.isfinite(w)) and np.all(np.isfinite(tau))):
-            self._prev = None
+            self._history = []
             return self._output()
-        prev = self._prev
-        self._prev = (t_ns, w)
-        if prev is None:
+        hist = self._history
+        if hist:
+            dt_s = (t_ns - hist[-1][0]) / NS_PER_S
+            if not 0.0 < dt_s <= self._params.max_gap_s:
+                hist.clear()
+        hist.append((t_ns, w, tau))
+        n = self._params.window_cycles
+        if len(hist) > n + 1:
+            del hist[0]
+        if len(hist) < n + 1:
             return self._output()
-        dt_s = (t_ns - prev[0]) / NS_PER_S
-        if not 0.0 < dt_s <= self._params.max_gap_s:
-            return self._output()
-        phi = euler_regressor(prev[1], w, dt_s)
+        phi, y = _window_equation(hist)
         if float(np.linalg.norm(phi)) < self._params.min_regressor_norm:
             return self._output()
-        self._step(phi, tau)
+        self._step(phi, y)
         return self._output()
 
     def _step(self, phi: np.ndarray, y: np.ndarray) -> None:
