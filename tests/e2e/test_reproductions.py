@@ -1,0 +1,86 @@
+"""The seed papers' simulations, each run with ``thruster-hil run`` in lockstep over the bus."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tests.e2e.conftest import REPO, run_cli, unique_bus
+
+pytestmark = pytest.mark.slow
+
+SCENARIOS = REPO / "scenarios"
+SEED000_MAX_THRUST_N = 5.0  # seed 000: every thrust within 5 N at every instant
+SEED003_BOUND_DEG = 3.0  # seed 003 Table 2: steady-state angle error < 3 deg
+TENFOLD = 10.0  # issue 3: at least 10x better than the paper's bound
+SEED001_INERTIA_KGM2 = np.array([[25.0, 0.8, -0.5], [0.8, 20.0, 0.6], [-0.5, 0.6, 15.0]])
+INERTIA_REL_TOL = 0.05  # identified principal moments within 5 % of the truth
+THRUST_TOL_N = 1e-9
+CONTINUOUS = ["--set", "thrusters.valve_model='throttled'",
+              "--set", "flight_sw.modulator={kind='proportional'}"]
+
+
+def _run(name: str, tmp_path: Path, runtime_dir: Path, *extra: str) -> tuple[dict[str, Any], Path]:
+    out = tmp_path / name
+    r = run_cli(["run", str(SCENARIOS / f"{name}.toml"), "--bus", unique_bus(), *extra],
+                out, runtime_dir)
+    assert (out / "summary.json").exists(), r.stderr[-2000:]
+    return r.summary, out
+
+
+def _failed(summary: dict[str, Any]) -> list[dict[str, Any]]:
+    return [e for e in summary["expectations"] if not e["pass"]]
+
+
+def _max_thrust_N(run_dir: Path) -> float:
+    with (run_dir / "telemetry.csv").open(newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    cols = [k for k in rows[0] if k.startswith("thrust_T")]
+    return max(float(r[k]) for r in rows for k in cols)
+
+
+@pytest.mark.parametrize("variant", ["on_off", "continuous"])
+def test_seed003_three_axis_tracking(tmp_path: Path, runtime_dir: Path, variant: str) -> None:
+    """Seed 003: converges within 10 s, steady-state error 10x inside Table 2's bound."""
+    extra = CONTINUOUS if variant == "continuous" else []
+    s, _ = _run("three_axis_tracking_cascade", tmp_path, runtime_dir, *extra)
+    assert s["passed"], _failed(s)
+    assert s["steady_state_attitude_error_deg"] <= SEED003_BOUND_DEG / TENFOLD
+
+
+def test_seed000_formation_keeping_nftsm_beats_tsm(tmp_path: Path, runtime_dir: Path) -> None:
+    """Seed 000: NFTSM meets its expectations within 5 N per thruster and converges before TSM."""
+    nftsm, out = _run("formation_keeping_nftsm", tmp_path, runtime_dir)
+    assert nftsm["passed"], _failed(nftsm)
+    assert _max_thrust_N(out) <= SEED000_MAX_THRUST_N + THRUST_TOL_N
+    tsm, _ = _run("formation_keeping_nftsm", tmp_path / "tsm", runtime_dir,
+                  "--set", "flight_sw.controller={kind='tsm_dq'}")
+    assert tsm["position_settling_time_s"] > nftsm["position_settling_time_s"]
+
+
+@pytest.mark.parametrize("allocator", ["robust_polytopic", "robust_polyhedral", "robust_lft"])
+def test_seed001_mrp_tracking_with_robust_allocation(
+    tmp_path: Path, runtime_dir: Path, allocator: str
+) -> None:
+    """Seed 001: the polynomial MRP trajectory is tracked with each robust allocator."""
+    s, out = _run("mrp_trajectory_tracking", tmp_path, runtime_dir,
+                  "--set", f"flight_sw.allocator={{kind='{allocator}'}}")
+    assert s["passed"], _failed(s)
+    stats = json.loads((out / "fsw_stats.json").read_text(encoding="utf-8"))
+    assert stats["allocation"]["cycles"] == s["fsw"]["cycles"]
+
+
+def test_seed001_capture_is_identified(tmp_path: Path, runtime_dir: Path) -> None:
+    """Seed 001 §2: after the capture, RLS identifies the new inertia within 5 %."""
+    s, out = _run("capture_inertia_identification", tmp_path, runtime_dir)
+    assert s["passed"], _failed(s)
+    assert [e["kind"] for e in s["events"]] == ["capture"]
+    stats = json.loads((out / "fsw_stats.json").read_text(encoding="utf-8"))
+    j = np.array(stats["inertia_estimate_B_kgm2"])
+    rel = np.abs(np.diag(j) - np.diag(SEED001_INERTIA_KGM2)) / np.diag(SEED001_INERTIA_KGM2)
+    assert np.all(rel <= INERTIA_REL_TOL), rel
