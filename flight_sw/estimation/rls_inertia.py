@@ -63,6 +63,7 @@ parametrisation of the momentum-based identification the seed cites as [7].
 
 from __future__ import annotations
 
+import itertools
 import math
 import numbers
 from collections.abc import Sequence
@@ -145,7 +146,7 @@ def _window_equation(
     total_s = (hist[-1][0] - hist[0][0]) / NS_PER_S
     gyro = np.zeros((N_AXES, N_PARAMS))
     impulse = np.zeros(N_AXES)
-    for (ta, wa, _), (tb, wb, tau_b) in zip(hist[:-1], hist[1:], strict=True):
+    for (ta, wa, _), (tb, wb, tau_b) in itertools.pairwise(hist):
         h = (tb - ta) / NS_PER_S
         gyro += TRAPEZOID_WEIGHT * h * (
             skew(wa) @ momentum_regressor(wa) + skew(wb) @ momentum_regressor(wb)

@@ -231,3 +231,37 @@ def test_invalid_params_are_rejected(kwargs: dict[str, object], key: str) -> Non
     with pytest.raises(ConfigError) as info:
         RlsInertiaParams(**args)  # type: ignore[arg-type]
     assert info.value.key == key
+
+
+WINDOW_CYCLES = 10
+LARGE_NOISE_RAD_S = 2e-4  # 10x the gyro noise above: the single-period regressor suffers
+
+
+def test_window_noise_free_converges_to_truth(clean_data: tuple[np.ndarray, np.ndarray]) -> None:
+    """Integrated over a window of periods, noise-free data still give the exact inertia."""
+    params = RlsInertiaParams(J_GUESS, forgetting_factor=1.0, window_cycles=WINDOW_CYCLES)
+    out = feed(RlsInertiaIdentifier(params), *clean_data)
+    assert all(j is None for j in out[:WINDOW_CYCLES])  # no estimate before a full window
+    final = out[-1]
+    assert final is not None
+    assert relative_error(final, J_TRUE) < NOISE_FREE_RTOL
+
+
+def test_window_reduces_the_noise_bias(clean_data: tuple[np.ndarray, np.ndarray]) -> None:
+    """With large rate noise, the windowed regressor's error is smaller than one period's."""
+    rates, torques = clean_data
+    noisy = rates + np.random.default_rng(2).normal(0.0, LARGE_NOISE_RAD_S, rates.shape)
+    errors = []
+    for window in (1, WINDOW_CYCLES):
+        params = RlsInertiaParams(J_GUESS, forgetting_factor=1.0, window_cycles=window)
+        final = feed(RlsInertiaIdentifier(params), noisy, torques)[-1]
+        assert final is not None
+        errors.append(relative_error(final, J_TRUE))
+    assert errors[1] < errors[0]
+
+
+@pytest.mark.parametrize("bad", [0, -1, 2.5, True])
+def test_window_cycles_validated(bad: object) -> None:
+    """window_cycles must be an integer >= 1; the error names the key."""
+    with pytest.raises(ConfigError, match="window_cycles"):
+        RlsInertiaParams(J_GUESS, window_cycles=bad)  # type: ignore[arg-type]
