@@ -19,6 +19,7 @@ import argparse
 import csv
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -173,7 +174,9 @@ def read_telemetry(run_dir: Path) -> dict[str, np.ndarray]:
     return cols
 
 
-def plot_comparison(rep: Reproduction, run_dirs: dict[str, Path], dest: Path) -> list[Path]:
+def plot_comparison(
+    rep: Reproduction, run_dirs: dict[str, Path], dest: Path, six_dof: bool
+) -> list[Path]:
     """Attitude error (and position error in 6 DoF) of every variant on shared axes."""
     import matplotlib
 
@@ -183,7 +186,6 @@ def plot_comparison(rep: Reproduction, run_dirs: dict[str, Path], dest: Path) ->
     tel = {v: read_telemetry(d) for v, d in run_dirs.items() if (d / "telemetry.csv").exists()}
     if not tel:
         return []
-    six_dof = any(np.ptp(t.get("rx_m", np.zeros(1))) > 0 for t in tel.values())
     fig, axes = plt.subplots(2 if six_dof else 1, 1, figsize=(8, 6 if six_dof else 3.5),
                              squeeze=False)
     for variant, t in tel.items():
@@ -207,6 +209,19 @@ def plot_comparison(rep: Reproduction, run_dirs: dict[str, Path], dest: Path) ->
     return [path]
 
 
+def copy_run_plots(rep: Reproduction, run_dirs: dict[str, Path], dest: Path) -> list[Path]:
+    """The first variant's own run plots (thruster raster, rates), renamed for the docs."""
+    variant, run_dir = next(iter(run_dirs.items()))
+    copied = []
+    for png in ("thruster_raster.png", "rates.png"):
+        src = run_dir / png
+        if src.exists():
+            target = dest / f"{rep.name}-{variant.replace('/', '-')}-{png}"
+            shutil.copyfile(src, target)
+            copied.append(target)
+    return copied
+
+
 def main() -> None:
     """Parse arguments, run every reproduction and variant, print JSON."""
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -220,15 +235,19 @@ def main() -> None:
         root = Path(args.keep) if args.keep else Path(tmp)
         for rep in chosen:
             dirs: dict[str, Path] = {}
+            six_dof = False
             for variant, sets in rep.variants.items():
                 out = root / rep.name / variant.replace("/", "-")
                 summary = run_scenario(SCENARIOS / rep.scenario, sets, out)
                 result["runs"][f"{rep.name}/{variant}"] = figures(summary, out)
                 dirs[variant] = out
+                six_dof = six_dof or summary.get("position_band_m") is not None
             if args.plots:
+                dest = Path(args.plots).resolve()
+                paths = plot_comparison(rep, dirs, dest, six_dof)
+                paths += copy_run_plots(rep, dirs, dest)
                 result.setdefault("plots", []).extend(
-                    str(x.relative_to(REPO) if x.is_relative_to(REPO) else x)
-                    for x in plot_comparison(rep, dirs, Path(args.plots).resolve())
+                    str(x.relative_to(REPO) if x.is_relative_to(REPO) else x) for x in paths
                 )
     print(json.dumps(result, indent=2, default=str))
 
