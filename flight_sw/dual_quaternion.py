@@ -39,6 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from flight_sw import quaternion as quat
+from flight_sw.quaternion import cross as cross3
 
 HALF = 0.5
 
@@ -112,8 +113,8 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Dual cross product ``â × b̂ = a × b + ϵ (a × b′ + a′ × b)`` of dual vectors (eq. 2)."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
-    real = np.cross(a[:3], b[:3])
-    dual = np.cross(a[:3], b[3:]) + np.cross(a[3:], b[:3])
+    real = cross3(a[:3], b[:3])
+    dual = cross3(a[:3], b[3:]) + cross3(a[3:], b[:3])
     return np.concatenate((real, dual))
 
 

@@ -104,6 +104,13 @@ def rotate(q_BN: np.ndarray, v_N: np.ndarray) -> np.ndarray:
     return to_dcm(q_BN) @ np.asarray(v_N, dtype=float)
 
 
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a × b`` of two 3-vectors (same result as ``np.cross``, ~20x cheaper on 3-vectors)."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def skew(v: np.ndarray) -> np.ndarray:
     """Cross-product matrix ``[v×]`` with ``[v×] w = v × w``."""
     v1, v2, v3 = np.asarray(v, dtype=float).tolist()

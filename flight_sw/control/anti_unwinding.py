@@ -37,6 +37,7 @@ import math
 
 import numpy as np
 
+from flight_sw.quaternion import cross as cross3
 from flight_sw.quaternion import skew
 
 HALF = 0.5
@@ -104,7 +105,7 @@ def jacobian_rate(q_e: np.ndarray, omega_e: np.ndarray, mu: float) -> np.ndarray
     w = np.asarray(omega_e, dtype=float)
     g, dg, ddg = gain_terms(q0, mu)
     dq0 = -HALF * float(qv @ w)
-    dqv = HALF * (q0 * w + np.cross(qv, w))
+    dqv = HALF * (q0 * w + cross3(qv, w))
     eye = np.eye(3)
     return HALF * (
         dg * dq0 * (q0 * eye + skew(qv))

@@ -49,6 +49,7 @@ from scipy.linalg import block_diag
 
 from dbc.errors import ConfigError
 from flight_sw import mrp
+from flight_sw.quaternion import cross as cross3
 from flight_sw.quaternion import error_quaternion
 
 N_AXES = 3
@@ -194,7 +195,7 @@ class MrpDirectParametric:
         c = -h @ mrp.kinematics_matrix_rate(eps, eps_dot) @ g
         x = np.concatenate((eps, eps_dot))
         generalised_Nm = h @ (self._zf0sq_vinv @ x) + c @ (self._zf0_vinv @ x)
-        n = np.cross(omega, j @ omega) - j @ np.cross(omega_err, omega_ref)
+        n = cross3(omega, j @ omega) - j @ cross3(omega_err, omega_ref)
         if domega_RN_B is not None:
             n = n + j @ np.asarray(domega_RN_B, dtype=float)
         return np.asarray(n + f.T @ generalised_Nm)

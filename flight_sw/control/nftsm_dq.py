@@ -72,6 +72,7 @@ import numpy as np
 from dbc.errors import ConfigError
 from flight_sw import dual_quaternion as dq
 from flight_sw.control import anti_unwinding as au
+from flight_sw.quaternion import cross as cross3
 from flight_sw.quaternion import error_quaternion, to_dcm
 
 N_AXES = 3
@@ -208,14 +209,14 @@ def relative_motion(
 
     # inertial twists: B at its origin in B axes; D (= R) at its origin in R axes
     omega_B = np.asarray(omega_BN_B, dtype=float) + C_BN @ omega_NI_N
-    vel_B = C_BN @ (v + leader_vel_N + np.cross(omega_NI_N, r))
+    vel_B = C_BN @ (v + leader_vel_N + cross3(omega_NI_N, r))
     twist_B = np.concatenate((omega_B, vel_B))
     omega_RN_R = C_BR.T @ np.asarray(omega_RN_B, dtype=float)
     omega_d = C_RN @ omega_NI_N + omega_RN_R
-    vel_d = C_RN @ (v_ref + leader_vel_N + np.cross(omega_NI_N, r_ref))
+    vel_d = C_RN @ (v_ref + leader_vel_N + cross3(omega_NI_N, r_ref))
     # derivatives of the R-axes components (ω_RN constant in R, v_ref constant in N)
-    domega_d = -np.cross(omega_RN_R, C_RN @ omega_NI_N)
-    dvel_d = -np.cross(omega_RN_R, vel_d) + C_RN @ np.cross(omega_NI_N, v_ref)
+    domega_d = -cross3(omega_RN_R, C_RN @ omega_NI_N)
+    dvel_d = -cross3(omega_RN_R, vel_d) + C_RN @ cross3(omega_NI_N, v_ref)
 
     dq_e = dq.short_way(dq.from_pose(q_BR, C_BN @ (r - r_ref)))
     twist_d_B = dq.transform_twist(dq_e, np.concatenate((omega_d, vel_d)))

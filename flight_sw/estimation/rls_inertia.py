@@ -63,7 +63,6 @@ parametrisation of the momentum-based identification the seed cites as [7].
 
 from __future__ import annotations
 
-import itertools
 import math
 import numbers
 from collections.abc import Sequence
@@ -136,24 +135,33 @@ def euler_regressor(omega_prev_B: np.ndarray, omega_B: np.ndarray, dt_s: float) 
     return momentum_regressor((w1 - w0) / dt_s) + TRAPEZOID_WEIGHT * gyro
 
 
-def _window_equation(
-    hist: list[tuple[int, np.ndarray, np.ndarray]],
-) -> tuple[np.ndarray, np.ndarray]:
+def _gyroscopic(omega_B: np.ndarray) -> np.ndarray:
+    """``[ω×] Ω(ω)`` (3×6): the gyroscopic term of Euler's equation, linear in θ."""
+    return skew(omega_B) @ momentum_regressor(omega_B)
+
+
+def _window_equation(hist: list[_Sample]) -> tuple[np.ndarray, np.ndarray]:
     """``(Φ, y)`` of Euler's equation integrated over the samples of ``hist`` (docstring)."""
     if len(hist) == 2:  # one period: the exact single-step form
-        (t0, w0, _), (t1, w1, tau1) = hist
-        return euler_regressor(w0, w1, (t1 - t0) / NS_PER_S), tau1
-    total_s = (hist[-1][0] - hist[0][0]) / NS_PER_S
-    gyro = np.zeros((N_AXES, N_PARAMS))
-    impulse = np.zeros(N_AXES)
-    for (ta, wa, _), (tb, wb, tau_b) in itertools.pairwise(hist):
-        h = (tb - ta) / NS_PER_S
-        gyro += TRAPEZOID_WEIGHT * h * (
-            skew(wa) @ momentum_regressor(wa) + skew(wb) @ momentum_regressor(wb)
-        )
-        impulse += h * tau_b
-    phi = momentum_regressor((hist[-1][1] - hist[0][1]) / total_s) + gyro / total_s
-    return phi, impulse / total_s
+        a, b = hist
+        return euler_regressor(a.omega_B, b.omega_B, (b.t_ns - a.t_ns) / NS_PER_S), b.torque_B_Nm
+    h = np.diff([x.t_ns for x in hist]) / NS_PER_S  # period lengths [s]
+    g = np.stack([x.gyro for x in hist])  # (N+1)×3×6
+    tau = np.stack([x.torque_B_Nm for x in hist[1:]])  # torque of each period
+    total_s = float(h.sum())
+    gyro = TRAPEZOID_WEIGHT * np.einsum("k,kij->ij", h, g[:-1] + g[1:])
+    phi = momentum_regressor((hist[-1].omega_B - hist[0].omega_B) / total_s) + gyro / total_s
+    return phi, h @ tau / total_s
+
+
+@dataclass(frozen=True)
+class _Sample:
+    """One update's data: time [ns], rate [rad/s], torque of the period before [N m]."""
+
+    t_ns: int
+    omega_B: np.ndarray
+    torque_B_Nm: np.ndarray
+    gyro: np.ndarray  # [ω×] Ω(ω), computed once per sample
 
 
 def _inertia_tuple(value: object) -> tuple[tuple[float, float, float], ...]:
@@ -226,7 +234,7 @@ class RlsInertiaIdentifier:
         self._theta = inertia_params(np.array(params.inertia_guess_B_kgm2))
         self._p = np.eye(N_PARAMS) * params.initial_covariance
         self._info = np.zeros((N_PARAMS, N_PARAMS))
-        self._history: list[tuple[int, np.ndarray, np.ndarray]] = []  # (t_ns, ω, T̄ before t)
+        self._history: list[_Sample] = []
         self._n_updates = 0
 
     @property
@@ -286,10 +294,10 @@ class RlsInertiaIdentifier:
             return self._output()
         hist = self._history
         if hist:
-            dt_s = (t_ns - hist[-1][0]) / NS_PER_S
+            dt_s = (t_ns - hist[-1].t_ns) / NS_PER_S
             if not 0.0 < dt_s <= self._params.max_gap_s:
                 hist.clear()
-        hist.append((t_ns, w, tau))
+        hist.append(_Sample(t_ns, w, tau, _gyroscopic(w)))
         n = self._params.window_cycles
         if len(hist) > n + 1:
             del hist[0]

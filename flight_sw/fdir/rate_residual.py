@@ -88,6 +88,7 @@ from flight_sw.fdir.base import (
     Verdict,
 )
 from flight_sw.fdir.thrust_model import ThrustModel
+from flight_sw.quaternion import cross as cross3
 
 NS_PER_S = 1_000_000_000
 S_PER_NS = 1e-9
@@ -404,7 +405,7 @@ class RateResidualFdir(ThrusterFdirStrategy):
         edges = ga.edges + gb.edges
         # angular channel
         w_bar = 0.5 * (w_a + w_b)
-        gyroscopic = self._j_inv @ np.cross(w_bar, self._j @ w_bar) * span_s
+        gyroscopic = self._j_inv @ cross3(w_bar, self._j @ w_bar) * span_s
         dw_pred = self._ang @ tau_s - gyroscopic
         r_ang = (w_b - w_a) - dw_pred
         contrib_ang = self._ang * tau_s  # (3, n)

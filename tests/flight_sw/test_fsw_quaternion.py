@@ -125,3 +125,13 @@ def test_normalise_rejects_zero() -> None:
     with pytest.raises(ValueError):
         qt.normalise(np.zeros(4))
     np.testing.assert_allclose(qt.normalise(np.array([2.0, 0, 0, 0])), qt.identity())
+
+
+def test_cross_matches_numpy_and_known_answer() -> None:
+    """``cross`` gives x × y = z and equals numpy's cross on random 3-vectors."""
+    np.testing.assert_array_equal(qt.cross(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])),
+                                  [0.0, 0.0, 1.0])
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        a, b = rng.normal(size=3), rng.normal(size=3)
+        np.testing.assert_allclose(qt.cross(a, b), np.cross(a, b), rtol=0.0, atol=1e-15)
