@@ -8,6 +8,7 @@ the configuration. Exit codes: 0 ok, 2 bad configuration or bus.
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 from pathlib import Path
 
@@ -49,6 +50,10 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     node = FlightNode(db, bus, computer, Path(args.stats) if args.stats else None)
     node.install_signal_handlers()
+    # Everything built so far (the DBC, the strategies) lives for the whole run: keep it out
+    # of the cyclic garbage collector's passes, which otherwise walk it inside cycles.
+    gc.collect()
+    gc.freeze()
     try:
         node.run(args.mode)
     finally:
