@@ -519,6 +519,9 @@ class BoundedQpAllocator:
             )
             self._m_mat = self._b_w.T @ self._b_w + eps * np.eye(k)
             self._definite = eps > 0.0
+        # the previous call's exact active set: the warm start of box_qp when OSQP stopped
+        # at its iteration cap without converging (its guess is then often far off)
+        self._state_prev: np.ndarray | None = None
 
     # --- introspection -----------------------------------------------------------------
 
@@ -554,6 +557,7 @@ class BoundedQpAllocator:
         self._u[:m] = d
         self._solver.update(l=self._l, u=self._u)
         res = self._solver.solve(raise_error=False)
+        converged = int(res.info.status_val) == int(osqp.SolverStatus.OSQP_SOLVED)
         x = np.asarray(res.x, dtype=float)
         k = self._avail.size
         t_qp = x[:k] if x.shape == (k + m,) and np.all(np.isfinite(x)) else np.zeros(k)
@@ -564,9 +568,12 @@ class BoundedQpAllocator:
         state = np.where(
             t_qp <= self._lo_a + tol, AT_LOWER, np.where(t_qp >= self._hi_a - tol, AT_UPPER, FREE)
         ).astype(np.int8)
-        t_qp, _ = box_qp(
+        if not converged and self._state_prev is not None and self._params.warm_start:
+            state = self._state_prev
+        t_qp, final_state = box_qp(
             self._m_mat, self._b_w.T @ d_w, self._lo_a, self._hi_a, state, self._definite
         )
+        self._state_prev = final_state
         refined = refine_on_active_set(self._b_w, d_w, t_qp, self._lo_a, self._hi_a)
         if refined is not None:
             r_ref = self._b_w @ refined - d_w
