@@ -99,7 +99,7 @@ OSQP_TIME_LIMIT_OFF_S = 1e10
 # BoundedQpAllocator only needs OSQP's active set (box_qp then solves exactly): loose
 # tolerances, no polishing, and a low iteration bound keep its worst case short.
 OSQP_STAGE_ONE_EPS = 1e-7
-OSQP_STAGE_ONE_MAX_ITER = 400
+OSQP_STAGE_ONE_MAX_ITER = 150
 
 _SOURCE = "BoundedQpParams"
 
