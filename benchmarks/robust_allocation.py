@@ -46,7 +46,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from collections.abc import Callable
@@ -57,6 +56,7 @@ from typing import Any
 
 import numpy as np
 
+from bench.valves.layouts import seed001_table1_16
 from flight_sw import mrp
 from flight_sw import quaternion as qt
 from flight_sw.allocation.effectiveness import TORQUE_ROWS, effectiveness_matrix
@@ -101,32 +101,12 @@ RK4_MID = 0.5
 RK4_WEIGHTS = (1.0, 2.0, 2.0, 1.0)
 RK4_SUM = 6.0
 
-# Seed 001 sec. 5: signed thrust bounds [N] and Table 1 (positions [m], the angles between
-# the thrust and the body x, y, z axes in units of π/2: the direction is their cosines).
+# Seed 001 sec. 5: signed thrust bounds [N]; Table 1's geometry comes from the bench's
+# layout (its first 8 valves are the paper's actuators; R = L = 0.75 m).
 SEED001_LOWER_N = -2.3
 SEED001_UPPER_N = 2.35
-_S = 0.375 * math.sqrt(2.0)
-SEED001_POSITIONS_M = (
-    (0.0, -0.75, 0.75),
-    (-0.75, -0.75, 0.0),
-    (0.0, -0.75, -0.75),
-    (0.75, -0.75, 0.0),
-    (_S, -0.75, _S),
-    (-_S, -0.75, _S),
-    (-_S, -0.75, -_S),
-    (_S, -0.75, -_S),
-)
-SEED001_DIRECTION_ANGLES_HALF_PI = (
-    (1, 1, 2),
-    (0, 1, 1),
-    (1, 1, 0),
-    (2, 1, 1),
-    (2, 1, 1),
-    (0, 1, 1),
-    (0, 1, 1),
-    (2, 1, 1),
-)
-DIRECTION_DECIMALS = 15  # cos(π/2) = 6e-17 → exactly 0
+SEED001_ARM_M = 0.75
+SEED001_ACTUATORS = 8
 
 # A thrust counts as violating its bounds beyond this [N].
 BOUND_TOL_N = 1e-9
@@ -168,9 +148,10 @@ Allocate = Callable[[np.ndarray], np.ndarray]
 
 def seed001_torque_matrix() -> np.ndarray:
     """3×8 torque rows of the seed-001 Table 1 effectiveness matrix [N m/N]."""
-    angles = np.array(SEED001_DIRECTION_ANGLES_HALF_PI, dtype=float) * math.pi / 2.0
-    dirs = np.round(np.cos(angles), DIRECTION_DECIMALS) + 0.0
-    return effectiveness_matrix(np.array(SEED001_POSITIONS_M), dirs)[TORQUE_ROWS]
+    geo = seed001_table1_16(SEED001_ARM_M, SEED001_ARM_M)[:SEED001_ACTUATORS]
+    r_thr_B = np.array([r for r, _ in geo])
+    d_thr_B = np.array([d for _, d in geo])
+    return effectiveness_matrix(r_thr_B, d_thr_B)[TORQUE_ROWS]
 
 
 def case1_torque_history(duration_s: float) -> tuple[np.ndarray, np.ndarray]:
