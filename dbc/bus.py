@@ -5,10 +5,18 @@ passed to :class:`can.Bus`, e.g. ``socketcan:vcan0``, ``virtual:test``, ``hilbus
 (the portable cross-process bus of :mod:`dbc.hilbus`), ``pcan:PCAN_USBBUS1?bitrate=1000000``.
 The default is ``socketcan:vcan0`` where the kernel has that interface, else
 ``hilbus:default``.
+
+SocketCAN buses get a large receive buffer (:data:`SOCKETCAN_RCVBUF_BYTES`): the kernel
+default (``net.core.rmem_default``, ~212 kB) holds only about 280 frames, and a socket
+whose buffer is full drops frames silently, so a bench or flight-software process that is
+briefly descheduled during a burst (a flood, a trace replay, a slow emulated CPU) would
+lose frames. ``SO_RCVBUFFORCE`` is used where the process may (CAP_NET_ADMIN), else
+``SO_RCVBUF``, which the kernel caps at ``net.core.rmem_max``.
 """
 
 from __future__ import annotations
 
+import socket
 from dataclasses import dataclass
 from pathlib import Path
 from urllib.parse import parse_qsl
@@ -21,6 +29,8 @@ DEFAULT_SOCKETCAN_CHANNEL = "vcan0"
 PORTABLE_INTERFACE = "hilbus"
 PORTABLE_DEFAULT_CHANNEL = "default"
 SYS_NET = Path("/sys/class/net")
+SOCKETCAN_RCVBUF_BYTES = 8 * 1024 * 1024  # ~10 000 queued frames (kernel skb accounting)
+SO_RCVBUFFORCE = getattr(socket, "SO_RCVBUFFORCE", 33)  # Linux value; missing on some builds
 
 
 @dataclass(frozen=True)
@@ -83,6 +93,25 @@ def open_bus(spec: str | BusSpec, **kwargs: object) -> can.BusABC:
     options = {k: _coerce(v) for k, v in bs.options}
     options.update(kwargs)
     try:
-        return can.Bus(interface=bs.interface, channel=bs.channel, **options)  # type: ignore[arg-type]
+        bus = can.Bus(interface=bs.interface, channel=bs.channel, **options)  # type: ignore[arg-type]
     except (can.CanError, OSError, ValueError, ImportError, NotImplementedError) as exc:
         raise BusError(f"cannot open bus {bs}: {exc}") from exc
+    sock = getattr(bus, "socket", None)
+    if bs.interface == "socketcan" and isinstance(sock, socket.socket):
+        enlarge_receive_buffer(sock)
+    return bus
+
+
+def enlarge_receive_buffer(sock: socket.socket, size_bytes: int = SOCKETCAN_RCVBUF_BYTES) -> int:
+    """Ask for a ``size_bytes`` receive buffer on ``sock``; returns what the kernel granted.
+
+    Tries ``SO_RCVBUFFORCE`` (needs CAP_NET_ADMIN), then ``SO_RCVBUF`` (capped by
+    ``net.core.rmem_max``); never raises for a refused size.
+    """
+    for option in (SO_RCVBUFFORCE, socket.SO_RCVBUF):
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, option, size_bytes)
+            break
+        except OSError:
+            continue
+    return int(sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF))

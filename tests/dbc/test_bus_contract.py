@@ -9,7 +9,9 @@ parsing and :func:`dbc.bus.default_bus_spec`.
 
 from __future__ import annotations
 
+import os
 import shutil
+import socket
 import tempfile
 import threading
 import time
@@ -21,7 +23,13 @@ from pathlib import Path
 import can
 import pytest
 
-from dbc.bus import BusSpec, default_bus_spec, open_bus
+from dbc.bus import (
+    SOCKETCAN_RCVBUF_BYTES,
+    BusSpec,
+    default_bus_spec,
+    enlarge_receive_buffer,
+    open_bus,
+)
 from dbc.errors import BusError
 
 DEADLINE_S = 30.0
@@ -255,3 +263,25 @@ def test_open_bus_passes_options(monkeypatch: pytest.MonkeyPatch) -> None:
             assert m is not None and m.arbitration_id == 0x33 and not m.is_rx
     finally:
         shutil.rmtree(runtime, ignore_errors=True)
+
+
+def test_enlarge_receive_buffer_grows_the_socket_buffer() -> None:
+    """The receive buffer grows past the kernel default; as root it reaches the request."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+        before = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        granted = enlarge_receive_buffer(sock, size_bytes=4 * before)
+        assert granted >= before
+        if os.geteuid() == 0:  # SO_RCVBUFFORCE: the kernel doubles what it is given
+            assert granted >= 4 * before
+
+
+@pytest.mark.socketcan
+def test_socketcan_bus_has_the_large_receive_buffer() -> None:
+    """open_bus gives a socketcan bus the receive buffer that absorbs a burst of frames."""
+    if not VCAN.exists():
+        pytest.skip("no SocketCAN interface vcan0 on this kernel")
+    with open_bus("socketcan:vcan0") as bus:
+        sock = bus.socket  # type: ignore[attr-defined]
+        granted = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
+        if os.geteuid() == 0:
+            assert granted >= SOCKETCAN_RCVBUF_BYTES
