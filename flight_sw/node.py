@@ -142,6 +142,7 @@ class FlightNode:
         self._last_sat = False
         self._last_residual = 0.0
         self._last_result: CycleResult | None = None
+        self._reported: tuple[int, int, int] | None = None  # (mode, FDIR, sensor flags) sent
         self._bench_time_ns: int | None = None  # newest BENCH_STATUS SimTime
         self._realtime = False
         self._time_aligned = False
@@ -261,7 +262,11 @@ class FlightNode:
         self.stats.residual_Nm.append(res.residual_Nm)
         self.stats.residual_N.append(res.residual_force_N)
         self.stats.saturated_cycles += bool(res.saturated)
-        if cycle % self.status_every == 0:
+        # Status at its DBC rate, and at once when the mode or a flag changes: the bench
+        # and the operator learn of a safe-mode entry or an isolation in the same cycle.
+        reported = (int(self.fc.mode), res.fdir_flags, res.sensor_flags)
+        if cycle % self.status_every == 0 or reported != self._reported:
+            self._reported = reported
             self.send_status(cycle)
         self.send_commands(cycle, res)
 

@@ -161,6 +161,23 @@ def test_imu_silence_latches_safe_mode_with_valves_closed(setup: tuple[FlightNod
     assert status.fdir_flags & FdirFlag.SAFE_LATCHED
 
 
+def test_safe_mode_entry_is_reported_in_the_same_cycle(setup: tuple[FlightNode, Bench]) -> None:
+    """The cycle that enters SAFE sends FSW_STATUS (Mode SAFE) at once, between status cycles."""
+    node, bench = setup
+    for k in range(3):  # cycle 0 is a status cycle; 1..4 are not
+        bench.sensors()
+        got = bench.sync(k)
+        assert ("FSW_STATUS" in got) == (k == 0)
+    reports = []
+    for k in range(3, 3 + SAFE_AFTER_CYCLES):
+        bench.sensors(imu=False)
+        reports.append(bench.sync(k).get("FSW_STATUS"))
+    assert k % node.status_every != 0  # not a regular status cycle
+    sent = [r for r in reports if r is not None]
+    assert len(sent) == 1 and sent[0]["Mode"] == Mode.SAFE
+    assert int(sent[0]["FdirFlags"]) & FdirFlag.SAFE_LATCHED
+
+
 def test_fsw_fdir_is_sent_with_each_status(setup: tuple[FlightNode, Bench]) -> None:
     """Status cycles carry FSW_FDIR: all 8 thrusters available, no failure, no sensor flag."""
     _, bench = setup
