@@ -69,13 +69,21 @@ def build_flood(n: int, seed: int) -> tuple[list[can.Message], dict[str, dict[st
 
 
 def send_flood(bus: can.BusABC, frames: list[can.Message], rate_hz: float) -> float:
-    """Send ``frames`` at ``rate_hz`` (paced by the monotonic clock); returns seconds taken."""
+    """Send ``frames`` at ``rate_hz`` (paced by the monotonic clock); returns seconds taken.
+
+    Between frames the flooder reads and discards what the bus delivers to it, as any CAN
+    controller receives the whole bus: on the portable bus, whose senders wait for room in
+    each member's queue rather than lose frames, a member that never read would stall the
+    bench and the flight software once its queue filled, which is not the hostile input
+    under test. The wait for the next slot is that receive (``recv`` with the time left).
+    """
     period = 1.0 / rate_hz
     t0 = time.monotonic()
     for i, msg in enumerate(frames):
-        lag = t0 + i * period - time.monotonic()
-        if lag > 0:
-            time.sleep(lag)  # pacing a transmitter, not waiting for an event
+        while bus.recv(timeout=0.0) is not None:
+            pass
+        while (lag := t0 + i * period - time.monotonic()) > 0:
+            bus.recv(timeout=lag)
         bus.send(msg)
     return time.monotonic() - t0
 
