@@ -22,6 +22,8 @@ ip -brief link show vcan0
 command -v candump >/dev/null || fail "candump (can-utils) not found"
 
 export PYTHONDONTWRITEBYTECODE=1 PYTHONUNBUFFERED=1 HOME=/tmp CI=true
+# one realtime run took 344 s alone and over 600 s in the full selection under TCG
+export THIL_TEST_RUN_TIMEOUT_S=1500
 "$PY" -m pytest -m socketcan -p no:cacheprovider --basetemp=/tmp/thil-pytest \
   --junitxml="$OUT/junit.xml" "$@"
 rc=$?
