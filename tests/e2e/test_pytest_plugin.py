@@ -180,7 +180,7 @@ def _live_against_realtime_run(bus: str, tmp_path: Path, runtime_dir: Path) -> d
     finally:
         if listener.poll() is None:
             listener.kill()
-            listener.wait()
+            listener.communicate()  # reaps it and closes its pipes
     assert listener.returncode == 0, stderr
     return {"live": json.loads(stdout), "run_dir": out}
 
