@@ -203,7 +203,7 @@ def build_parser() -> argparse.ArgumentParser:
             r.add_argument(
                 "--fsw-cmd",
                 help="flight-software command; placeholders {bus} {mode} "
-                "{config} {stats} {run_dir}",
+                "{config} {stats} {rx_log} {run_dir}",
             )
     rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
     rp.add_argument("run_dir")

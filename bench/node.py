@@ -197,6 +197,7 @@ class BenchNode:
         self.max_lag_ns = 0  # realtime: how far the plant fell behind the wall clock
         self._rt_clock: Clock | None = None  # realtime: sensor frames go out as sampled
         self._rt_end_ns = 0
+        self.wall_origin_s: float | None = None  # realtime: time.time() at the run's t = 0
         self.fsw_status: dict[str, float] = {}
         self.fsw_q_est: tuple[float, float, float, float] | None = None
         self.fsw_q_valid = False
@@ -772,6 +773,7 @@ class BenchNode:
         self.wait_for_fsw()
         self.trace.event(0, "run_started", mode=self.mode, seed=self.seed)
         clock = clock or Clock()
+        self.wall_origin_s = clock.wall0_s
         end_ns = round(duration_s * NS_PER_S)
         self._rt_end_ns = end_ns
         self._queue_due(0)
@@ -889,6 +891,7 @@ class BenchNode:
             "bitrate_bps": sc.bus.bitrate_bps,
             "sim_time_s": sim_time_s,
             "wall_time_s": round(self.wall_s, 3),
+            "wall_clock_origin_s": self.wall_origin_s,
             "realtime_factor": round(sim_time_s / self.wall_s, 2) if self.wall_s > 0 else None,
             "converged": pm.converged,
             "settling_band_deg": sc.expectations.settling_band_deg,

@@ -4,9 +4,11 @@ The flight software is started by command (``--fsw-cmd``, ours by default), exac
 real bench starts someone else's flight-software binary, so the bench never imports it.
 Placeholders in the command: ``{bus}``, ``{mode}``, ``{config}`` (the flight-software
 configuration JSON written into the run folder), ``{stats}`` (where it may write its
-statistics JSON) and ``{run_dir}``. The run folder always ends up with ``summary.json``,
-``trace.asc``, ``telemetry.csv``, ``valve_pulses.csv``, ``events.jsonl``, ``fsw.log`` and
-the PNG plots, even when the flight software dies.
+statistics JSON), ``{rx_log}`` (where it may log when each frame arrived, realtime:
+``fsw_rx.csv``, see :mod:`bench.analysis.reception`) and ``{run_dir}``. The run folder
+always ends up with ``summary.json``, ``trace.asc``, ``telemetry.csv``,
+``valve_pulses.csv``, ``events.jsonl``, ``fsw.log`` and the PNG plots, even when the flight
+software dies.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from bench.analysis.reception import RX_LOG_FILE
 from bench.metrics import pointing_metrics
 from bench.node import BenchNode, frame_table, merge_counts
 from bench.plots import plot_run
@@ -39,7 +42,7 @@ from dbc.errors import ConfigError, RunError
 
 DEFAULT_FSW_CMD = (
     f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
-    "--config {config} --stats {stats}"
+    "--config {config} --stats {stats} --rx-log {rx_log}"
 )
 FSW_TERM_TIMEOUT_S = 5.0
 EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH = 0, 3, 4
@@ -69,13 +72,14 @@ class RunOptions:
 def _fsw_argv(template: str, opts: RunOptions, config: Path, stats: Path) -> list[str]:
     try:
         return [
-            a.format(bus=opts.bus, mode=opts.mode, config=config, stats=stats, run_dir=opts.out)
+            a.format(bus=opts.bus, mode=opts.mode, config=config, stats=stats, run_dir=opts.out,
+                     rx_log=opts.out / RX_LOG_FILE)
             for a in shlex.split(template)
         ]
     except (KeyError, IndexError, ValueError) as exc:
         raise ConfigError("command line", "--fsw-cmd", template,
                           f"placeholders among {{bus}} {{mode}} {{config}} {{stats}} {{run_dir}} "
-                          f"({exc})") from exc
+                          f"{{rx_log}} ({exc})") from exc
 
 
 class Terminated(Exception):  # noqa: N818 - a request, not an error

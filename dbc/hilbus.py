@@ -59,11 +59,13 @@ Wire record: a little-endian header :data:`HEADER` (``<dIBBB``: transmission tim
 sender's :func:`time.time`, arbitration ID, flags, DLC, data length) followed by 0..64 data
 bytes. Flags: extended ID, remote, error, FD, bit-rate switch, error-state indicator.
 Received frames are :class:`HilMessage` objects (a :class:`can.Message`):
-``timestamp`` is the *receiver's* :func:`time.time` at receipt, as for every python-can
-interface, and ``tx_timestamp`` the sender's time of transmission, so one-way latency is
-``msg.timestamp - msg.tx_timestamp`` (same host, same clock). :func:`tx_timestamp_of`
-reads it from any message (None when it is not a hilbus frame). Filters are python-can's
-standard software filters. Malformed datagrams are dropped and counted in
+``timestamp`` is the wall-clock time the frame arrived in the receiver's queue, stamped by
+the kernel (``SO_TIMESTAMPNS``, as SocketCAN's receive timestamps are; elsewhere than Linux
+the receiver's :func:`time.time` when it reads the frame), and ``tx_timestamp`` the
+sender's time of transmission, so one-way latency is ``msg.timestamp - msg.tx_timestamp``
+(same host, same clock) and does not include how long the receiver took to read.
+:func:`tx_timestamp_of` reads it from any message (None when it is not a hilbus frame).
+Filters are python-can's standard software filters. Malformed datagrams are dropped and counted in
 :attr:`HilBus.malformed_records`; they never raise. ``state = BusState.PASSIVE`` makes a
 member listen-only (``send`` raises); ``fileno()`` is readable whenever a frame waits, so
 :class:`can.Notifier` (threads or asyncio) works. ``send`` may be called from several
@@ -136,6 +138,13 @@ FULL_RETRY_S = 0.001
 SPURIOUS_WRITABLE_LIMIT = 3
 
 #: wire header: tx time (s), arbitration ID, flags, DLC, data length.
+# Linux stamps a datagram as it is queued to a socket that asked for SO_TIMESTAMPNS
+# (<asm-generic/socket.h>; Python's socket module does not name it); the stamp comes back
+# as an SCM_TIMESTAMPNS control message carrying a struct timespec.
+SO_TIMESTAMPNS = 35
+TIMESPEC = struct.Struct("@qq")
+TIMESTAMP_CMSG_B = socket.CMSG_SPACE(TIMESPEC.size)
+NS_PER_S = 1_000_000_000
 HEADER = struct.Struct("<dIBBB")
 DATA_MAX_B = 64
 CLASSIC_DATA_MAX_B = 8
@@ -283,6 +292,17 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
+def _ask_for_timestamps(sock: socket.socket) -> bool:
+    """Ask the kernel to stamp each datagram's arrival (Linux); True if it will."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+    except OSError:
+        return False
+    return True
+
+
 def _set_buffers(sock: socket.socket) -> None:
     for opt in (socket.SO_SNDBUF, socket.SO_RCVBUF):
         with contextlib.suppress(OSError):
@@ -348,6 +368,7 @@ class HilBus(can.BusABC):
         sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
         try:
             _set_buffers(sock)
+            self._kernel_stamps = _ask_for_timestamps(sock)
             sock.bind(os.fspath(path))
             os.chmod(path, SOCKET_MODE)
         except OSError as exc:
@@ -533,11 +554,29 @@ class HilBus(can.BusABC):
     def _drain_locked(self) -> None:
         while True:
             try:
-                record = self._sock.recv(RECORD_MAX_B, socket.MSG_DONTWAIT)
+                record, rx_time = self._recv_record()
             except BlockingIOError:
                 break
             if record:
-                self._backlog.append((time.time(), record))
+                self._backlog.append((rx_time, record))
+
+    def _recv_record(self) -> tuple[bytes, float]:
+        """One datagram of our socket (non-blocking) and its time of arrival.
+
+        The arrival time is the kernel's stamp of when the datagram was queued to us (as
+        SocketCAN's receive timestamps are), else :func:`time.time` now. Raises
+        BlockingIOError when nothing is queued.
+        """
+        if not self._kernel_stamps:
+            return self._sock.recv(RECORD_MAX_B, socket.MSG_DONTWAIT), time.time()
+        record, ancillary, _flags, _addr = self._sock.recvmsg(
+            RECORD_MAX_B, TIMESTAMP_CMSG_B, socket.MSG_DONTWAIT
+        )
+        for level, kind, data in ancillary:
+            if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(data) >= TIMESPEC.size:
+                sec, nsec = TIMESPEC.unpack_from(data)
+                return record, sec + nsec / NS_PER_S
+        return record, time.time()
 
     def _wake_self(self) -> None:
         """Queue an empty datagram so fileno() reads as readable while a backlog waits."""
@@ -569,12 +608,11 @@ class HilBus(can.BusABC):
                     rx_time, record = self._backlog.popleft()
                 else:
                     try:
-                        record = self._sock.recv(RECORD_MAX_B, socket.MSG_DONTWAIT)
+                        record, rx_time = self._recv_record()
                     except BlockingIOError:
                         record = None
                     except OSError as exc:
                         raise can.CanOperationError(f"hilbus: receive failed: {exc}") from exc
-                    rx_time = time.time()
             if record is None:
                 wait_ms = _poll_ms(deadline)
                 if wait_ms == 0 or not self._poller.poll(wait_ms):

@@ -2,7 +2,8 @@
 
 Opens the bus, builds the flight computer from ``--config`` and runs it in lockstep (one
 cycle per SYNC) or realtime (own timer) until SIGTERM/SIGINT. ``--check`` only validates
-the configuration. Exit codes: 0 ok, 2 bad configuration or bus.
+the configuration. ``--rx-log`` (realtime) logs when each frame arrived
+(:mod:`flight_sw.rx_log`). Exit codes: 0 ok, 2 bad configuration, bus or log path.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from dbc.codec import cycle_time_ns
 from dbc.errors import BusError, ConfigError
 from flight_sw.config import build_computer, load_config
 from flight_sw.node import FlightNode
+from flight_sw.rx_log import ReceiveLog
 
 EXIT_BAD_INPUT = 2
 
@@ -31,6 +33,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
     p.add_argument("--stats", help="write frame and cycle statistics JSON here")
+    p.add_argument(
+        "--rx-log",
+        help="realtime: log every received frame's receive timestamp, ID and alive counter "
+        "to this CSV file (the bench's timing analysis turns it into bench-frame latency)",
+    )
     p.add_argument("--check", action="store_true", help="validate the configuration and exit")
     args = p.parse_args(argv)
     db = load_database()
@@ -48,7 +55,13 @@ def main(argv: list[str] | None = None) -> int:
     except (ConfigError, BusError) as exc:
         print(f"flight_sw: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    node = FlightNode(db, bus, computer, Path(args.stats) if args.stats else None)
+    try:
+        rx_log = ReceiveLog(Path(args.rx_log)) if args.rx_log and args.mode == "realtime" else None
+    except OSError as exc:
+        print(f"flight_sw: error: --rx-log {args.rx_log}: {exc}", file=sys.stderr)
+        bus.shutdown()
+        return EXIT_BAD_INPUT
+    node = FlightNode(db, bus, computer, Path(args.stats) if args.stats else None, rx_log)
     node.install_signal_handlers()
     # Everything built so far (the DBC, the strategies) lives for the whole run: keep it out
     # of the cyclic garbage collector's passes, which otherwise walk it inside cycles.
@@ -58,6 +71,8 @@ def main(argv: list[str] | None = None) -> int:
         node.run(args.mode)
     finally:
         bus.shutdown()
+        if rx_log is not None:
+            rx_log.close()
     return 0
 
 

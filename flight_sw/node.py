@@ -17,8 +17,9 @@ Heartbeat: FSW_STATUS alone at start-up and after every second without any recei
 
 Modes: ``lockstep`` — one control cycle per SYNC(k), at the simulation time it carries;
 ``realtime`` — cycles on this process's own monotonic timer (period from the DBC), with
-overruns counted. Status and attitude telemetry go out every FSW_STATUS period. Runs
-until SIGTERM/SIGINT, then writes its statistics file and exits 0.
+overruns counted; with a receive log (:mod:`flight_sw.rx_log`) every frame read is logged
+with its receive timestamp, flushed per cycle. Status and attitude telemetry go out every
+FSW_STATUS period. Runs until SIGTERM/SIGINT, then writes its statistics file and exits 0.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from dbc.quaternion import pack_quaternion, unpack_quaternion
 from flight_sw.clock import MonotonicClock
 from flight_sw.computer import CycleResult, FlightComputer
 from flight_sw.fdir.base import NO_THRUSTER
+from flight_sw.rx_log import ReceiveLog
 
 THRUSTERS_PER_CMD_FRAME = 4
 HEARTBEAT_RETRY_S = 1.0
@@ -121,8 +123,10 @@ class FlightNode:
         bus: can.BusABC,
         computer: FlightComputer,
         stats_path: Path | None = None,
+        rx_log: ReceiveLog | None = None,
     ) -> None:
         self.db = db
+        self.rx_log = rx_log  # realtime: when each frame arrived (flight_sw/rx_log.py)
         self.bus = bus
         self.fc = computer
         self.encoder = Encoder(db)
@@ -379,6 +383,8 @@ class FlightNode:
             if now < next_ns:
                 msg = self.bus.recv(timeout=(next_ns - now) / 1e9)
                 if msg is not None:
+                    if self.rx_log is not None:
+                        self.rx_log.row(msg)
                     d = self.checker.check(msg)
                     if d is not None:
                         t = clock.now_ns()
@@ -388,6 +394,8 @@ class FlightNode:
                         self._pending_seen.clear()
                 continue
             self.run_cycle(cycle, next_ns)
+            if self.rx_log is not None:
+                self.rx_log.flush()
             cycle += 1
             next_ns += period
             done = clock.now_ns()

@@ -138,7 +138,7 @@ def format_report(rt: RunTiming) -> str:
         )
     if rt.mode != "lockstep":
         unknown = (
-            "the flight software's reception of bench frames is not known"
+            "the flight software logged no reception of that message (fsw_rx.csv)"
             if rt.mode == "realtime"
             else "latency needs the sender's time, which hilbus carries and SocketCAN does not"
         )

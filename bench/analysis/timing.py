@@ -33,8 +33,8 @@ statistic is ``nan`` with ``n = 0``, so an assertion ``x < limit`` on it fails.
 Assumptions
 -----------
 * A frame's *seen* time is ``t_rx`` where known, else ``t_ready`` (a realtime bench
-  frame: the flight software's reception is unknown; the virtual buses deliver within
-  tens of microseconds of sending). Periods use seen times.
+  frame whose reception the flight software did not log in ``fsw_rx.csv``; the virtual
+  buses deliver within tens of microseconds of sending). Periods use seen times.
 * Rows with ``bits == 0`` have no place on the bus time line (the flight software's boot
   heartbeat, recorded before the run's time starts): counted, excluded from all timing.
 * Missed cycles: an inter-arrival gap longer than ``missed_gap_periods`` cycle times
@@ -69,6 +69,7 @@ No clock is read here.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -85,6 +86,7 @@ from bench.analysis.defaults import (
     DEFAULT_MISSED_GAP_PERIODS,
     DEFAULT_WINDOW_MS,
 )
+from bench.analysis.reception import RX_LOG_COLUMNS, RX_LOG_FILE, fill_reception, receive_log
 from bench.bus.rta import messages_from_dbc, response_times
 from bench.recorder import CHAIN_COLUMNS, FRAME_COLUMNS
 from dbc import load_database
@@ -638,7 +640,11 @@ class RunTiming:
     def load(
         cls, run_dir: Path | str, options: TimingOptions | None = None, db: Any = None
     ) -> RunTiming:
-        """Read ``frames.csv``, ``chains.csv`` (optional) and ``summary.json`` of a run folder."""
+        """Read ``frames.csv``, ``chains.csv`` (optional) and ``summary.json`` of a run folder.
+
+        Realtime: with the flight software's receive log (``fsw_rx.csv``) the bench's frames
+        get their reception times from it (:mod:`bench.analysis.reception`).
+        """
         d = Path(run_dir)
         summary_path = d / "summary.json"
         try:
@@ -650,6 +656,11 @@ class RunTiming:
         db = load_database() if db is None else db
         bitrate = summary.get("bitrate_bps") or _dbc_bitrate_bps(db)
         frames = FrameTable.from_columns(read_csv_columns(d / "frames.csv", FRAME_COLUMNS))
+        origin = summary.get("wall_clock_origin_s")
+        if summary.get("mode") == "realtime" and origin is not None and (d / RX_LOG_FILE).exists():
+            log = receive_log(read_csv_columns(d / RX_LOG_FILE, RX_LOG_COLUMNS), float(origin))
+            frames = dataclasses.replace(frames, t_rx_s=fill_reception(
+                frames.t_ready_s, frames.t_rx_s, frames.can_id, frames.tx, frames.counter, log))
         chains = (
             ChainTable.from_columns(read_csv_columns(d / "chains.csv", CHAIN_COLUMNS))
             if (d / "chains.csv").exists()

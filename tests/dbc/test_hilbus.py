@@ -573,3 +573,19 @@ def test_can_logger_prints_frames(runtime: Path, channel: str) -> None:
                 logger.kill()
                 logger.wait()
     assert list(channel_dir(channel).iterdir()) == []
+
+
+READ_LATER_S = 0.2  # how long the frame waits in the queue before it is read
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="kernel stamps are Linux's")
+def test_timestamp_is_the_arrival_not_the_read(pair: tuple[HilBus, HilBus]) -> None:
+    """A frame read late keeps the kernel's arrival time: latency excludes the reader's delay."""
+    a, b = pair
+    a.send(can.Message(arbitration_id=0x40, data=b"\x01\x02", is_extended_id=False))
+    time.sleep(READ_LATER_S)  # the stimulus: the frame waits unread in b's queue
+    read_s = time.time()
+    m = b.recv(timeout=DEADLINE_S)
+    assert m is not None and m.tx_timestamp is not None
+    assert m.tx_timestamp <= m.timestamp < m.tx_timestamp + READ_LATER_S / 2
+    assert read_s - m.timestamp >= READ_LATER_S / 2

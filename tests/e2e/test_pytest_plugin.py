@@ -22,6 +22,7 @@ from typing import Any
 
 import pytest
 
+from bench.analysis.reception import PAIRING_TOLERANCE_S
 from tests.e2e.conftest import QUICKSTART, REPO, run_cli, unique_bus
 
 LOCKSTEP_S = "5"
@@ -32,6 +33,8 @@ LIVE_S = "2"  # from the first frame (the flight software's heartbeat): inside t
 FIRST_FRAME_TIMEOUT_S = "900"
 PYTEST_TIMEOUT_S = 600
 LISTENER_TIMEOUT_S = 300
+US_PER_S = 1e6
+UNREAD_AT_END_MAX = 2  # bench frames sent as the run ends, after the flight software's last read
 USAGE_ERROR = 4  # pytest's exit code for a usage error
 EXAMPLES = REPO / "tests" / "timing_examples"
 VCAN = Path("/sys/class/net/vcan0")
@@ -185,6 +188,18 @@ def _live_against_realtime_run(bus: str, tmp_path: Path, runtime_dir: Path) -> d
     return {"live": json.loads(stdout), "run_dir": out}
 
 
+def _check_bench_frames_received(t: dict[str, Any], run_dir: Path) -> None:
+    """The bench's frames have the flight software's reception times (from fsw_rx.csv)."""
+    assert (run_dir / "fsw_rx.csv").stat().st_size > 0
+    for name in ("IMU_RATE", "STR_QUAT", "THR_STATUS"):
+        m = t["messages"][name]
+        assert m["time_source"] in ("t_rx", "mixed"), name
+        assert m["latency"]["n"] >= m["count"] - UNREAD_AT_END_MAX, name
+        assert m["jitter_std_us"] is not None, name
+        # never received before it was sent (beyond the pairing tolerance)
+        assert m["latency"]["p50_us"] >= -PAIRING_TOLERANCE_S * US_PER_S, name
+
+
 def _check_live(live: dict[str, Any], bus: str, latency_known: bool) -> None:
     assert live["mode"] == "live" and live["bus"] == bus
     for name in REALTIME_MESSAGES:
@@ -211,8 +226,7 @@ def test_live_timing_of_realtime_run_on_portable_bus(tmp_path: Path, runtime_dir
     for name in ("THR_CMD_0", "FSW_STATUS"):  # received by the bench: latency measured
         m = t["messages"][name]
         assert m["latency"]["n"] > 0 and m["jitter_std_us"] is not None, name
-    imu = t["messages"]["IMU_RATE"]  # sent by the bench: period from its send times
-    assert imu["time_source"] == "t_ready" and imu["jitter_std_us"] is not None
+    _check_bench_frames_received(t, res["run_dir"])
     assert t["chain"]["imu_to_command"]["n"] > 0
     assert not math.isnan(t["bus_load"]["total"]["mean_pct"])
 
@@ -220,7 +234,11 @@ def test_live_timing_of_realtime_run_on_portable_bus(tmp_path: Path, runtime_dir
 @pytest.mark.socketcan
 @pytest.mark.skipif(not VCAN.exists(), reason="no SocketCAN interface vcan0 on this kernel")
 def test_live_timing_on_vcan(tmp_path: Path, runtime_dir: Path) -> None:
-    """--live on socketcan:vcan0 measures periods and load of a realtime run (no latency)."""
+    """--live on vcan0 measures periods and load (no latency); the run folder has latency."""
     bus = "socketcan:vcan0"
     res = _live_against_realtime_run(bus, tmp_path, runtime_dir)
     _check_live(res["live"], bus, latency_known=False)  # SocketCAN has no sender's time
+    # the run folder: the bench's frames get the flight software's kernel receive times
+    p = _timing([str(res["run_dir"]), "--json"])
+    assert p.returncode == 0, p.stderr
+    _check_bench_frames_received(json.loads(p.stdout), res["run_dir"])
