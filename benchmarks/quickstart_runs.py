@@ -4,7 +4,8 @@ Runs ``thruster-hil run scenarios/quickstart.toml`` N times in lockstep over the
 bus (each in a private runtime directory) and, optionally, once in realtime mode; prints
 one JSON object: per-run and median real-time factor and wall time, the flight software's
 cycle time percentiles (SYNC receipt to last frame sent), and for the realtime run the
-measured sensor-to-command latency and deadline misses. Medians over one invocation: this
+measured sensor-to-command latency, the one-way latency of single messages each way and
+deadline misses. Medians over one invocation: this
 machine is shared and noisy.
 
     python benchmarks/quickstart_runs.py --runs 5 --realtime-s 60
@@ -23,8 +24,13 @@ import uuid
 from pathlib import Path
 from typing import Any
 
+from bench.analysis.timing import RunTiming
+
 REPO = Path(__file__).resolve().parents[1]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
+
+
+ONE_WAY = ("IMU_RATE", "STR_QUAT", "THR_CMD_0")  # bench -> flight software, and back
 
 
 def _run(extra: list[str], scratch: Path, bus: str | None = None) -> dict[str, Any]:
@@ -37,7 +43,9 @@ def _run(extra: list[str], scratch: Path, bus: str | None = None) -> dict[str, A
          "--out", str(out), *extra],
         cwd=REPO, env=env, capture_output=True, check=False,
     )
-    return json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    summary: dict[str, Any] = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    summary["run_dir"] = str(out)
+    return summary
 
 
 def main() -> None:
@@ -71,6 +79,7 @@ def main() -> None:
         if args.realtime_s > 0:
             rt = _run(["--mode", "realtime", "--duration", str(args.realtime_s)], scratch,
                       args.realtime_bus)
+            timing = RunTiming.load(rt["run_dir"])
             result["realtime"] = {
                 "bus": rt["bus"],
                 "sim_time_s": rt["sim_time_s"],
@@ -78,6 +87,11 @@ def main() -> None:
                 "settling_time_s": rt["settling_time_s"],
                 "steady_state_attitude_error_deg": rt["steady_state_attitude_error_deg"],
                 "latency_us_sensor_to_command": rt["latency_us"]["sensor_to_command"],
+                # sending to the receiver's arrival stamp, per message (bench frames: from
+                # the flight software's receive log, fsw_rx.csv)
+                "one_way_latency_us": {
+                    name: timing.message(name).latency.to_dict() for name in ONE_WAY
+                },
                 "deadline_misses": rt["deadline_misses"],
                 "fsw_cycle_time_us": rt["fsw"].get("cycle_time_us"),
             }
