@@ -211,6 +211,14 @@ def _run_bench(
             v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns")
         )
     summary["warnings"] = bus_warnings(summary["frames"])
+    # hilbus: frames the bench could not deliver to a member that stopped reading
+    drops = getattr(bus, "overrun_drops", 0)
+    summary["bus_overrun_drops"] = drops
+    if drops:
+        summary["warnings"].append(
+            f"{drops} bench frames were dropped for a bus member that stopped reading "
+            "(e.g. a paused can.logger); the flight software was not affected unless it "
+            "was that member")
     if any("another node" in w for w in summary["warnings"]):
         summary["passed"] = False
     if error is not None:

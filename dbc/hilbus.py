@@ -41,6 +41,12 @@ Design
   10): a slow receiver slows its senders down instead of losing frames. While blocked, a
   sender keeps draining its *own* socket into a local backlog, so two single-threaded
   processes bursting at each other do not deadlock.
+* Overrun: a member whose queue stays full for ``member_stall_s`` (default
+  :data:`MEMBER_STALL_S`; a stopped ``can.logger``, a process that opened the bus only to
+  send) is *overrun*, as a CAN controller whose receive buffer overflows: senders drop
+  their frames to it, without waiting, until its queue has room again, and count them in
+  :attr:`HilBus.overrun_drops`. Every other member still gets every frame, so a stuck
+  monitor cannot stop a run. ``member_stall_s=None`` blocks without limit instead.
 * ``receive_own_messages=True`` delivers each sent frame locally too (``is_rx=False``),
   after it went out to the other members.
 
@@ -77,8 +83,9 @@ Limits
 * No physical layer: no bitrate, no arbitration, no bus-off (``bitrate`` etc. are
   accepted and ignored); the bench's bus timing model supplies those.
 * A member that never reads (a process that opened the bus only to send, or is stopped)
-  eventually blocks every sender; use ``send(msg, timeout=...)`` to bound that. A send that
-  times out may have reached some members and not others.
+  holds every sender up for ``member_stall_s`` once, then loses frames (see Overrun).
+  ``send(msg, timeout=...)`` bounds a send in total; one that times out may have reached
+  some members and not others.
 * A member that joins while a frame is being sent may miss that frame.
 * ``shutdown()`` wakes threads blocked in ``recv()`` or ``send()`` on the same object
   (they raise :class:`can.CanOperationError`).
@@ -136,6 +143,10 @@ UNSETTLED_RESCAN_NS = 1_000_000
 FULL_RETRY_S = 0.001
 #: consecutive "peer writable, send still would block" before falling back to retries.
 SPURIOUS_WRITABLE_LIMIT = 3
+# a member whose queue stays full this long is overrun (its frames dropped until it reads):
+# far beyond a busy process's scheduling delay, and below the bench's default lockstep
+# stall timeout (2 s), so a paused monitor holds a run up once without costing it a stall
+MEMBER_STALL_S = 1.0
 
 #: wire header: tx time (s), arbitration ID, flags, DLC, data length.
 # Linux stamps a datagram as it is queued to a socket that asked for SO_TIMESTAMPNS
@@ -327,6 +338,8 @@ class _Peer:
     sock: socket.socket
     #: waits for room in the peer's queue or for a datagram in our own (see _send_to)
     poller: Any
+    #: its queue stayed full for member_stall_s: frames to it are dropped until it has room
+    overrun: bool = False
 
 
 class HilBus(can.BusABC):
@@ -335,6 +348,8 @@ class HilBus(can.BusABC):
     :param channel: channel name (``[A-Za-z0-9_.-]+``), default ``"default"``.
     :param receive_own_messages: also deliver this member's own sent frames to itself.
     :param can_filters: python-can software filters.
+    :param member_stall_s: how long a send waits for a member whose queue is full before
+        that member is overrun (its frames dropped until it reads); None: no limit.
     Other keyword arguments (``bitrate``, ``fd``, ...) are accepted and ignored.
     """
 
@@ -343,8 +358,14 @@ class HilBus(can.BusABC):
         channel: Any = DEFAULT_CHANNEL,
         can_filters: CanFilters | None = None,
         receive_own_messages: bool = False,
+        member_stall_s: float | None = MEMBER_STALL_S,
         **kwargs: object,
     ) -> None:
+        if member_stall_s is not None and not (
+            isinstance(member_stall_s, (int, float)) and member_stall_s >= 0
+        ):
+            raise BusError(f"hilbus: member_stall_s = {member_stall_s!r}: expected seconds >= 0 "
+                           "or None")
         if not hasattr(socket, "AF_UNIX") or not hasattr(os, "getuid"):
             raise BusError("hilbus needs Unix domain sockets (not available on this OS)")
         name = check_channel(DEFAULT_CHANNEL if channel is None else channel)
@@ -385,6 +406,9 @@ class HilBus(can.BusABC):
         self.receive_own_messages = bool(receive_own_messages)
         #: datagrams received that were not valid records (dropped).
         self.malformed_records = 0
+        #: frames this member did not deliver to an overrun member (see the module docstring).
+        self.overrun_drops = 0
+        self.member_stall_s = member_stall_s
         self._name = path.name
         self._path_b = os.fsencode(path)
         self._sock = sock
@@ -510,9 +534,12 @@ class HilBus(can.BusABC):
 
     def _send_to(self, peer: _Peer, record: bytes, deadline: float | None) -> None:
         spurious = 0
+        stall = self.member_stall_s
+        stall_deadline = None if stall is None else time.monotonic() + stall
         while True:
             try:
                 peer.sock.send(record, socket.MSG_DONTWAIT)
+                peer.overrun = False
                 return
             except BlockingIOError:
                 full_retry = spurious >= SPURIOUS_WRITABLE_LIMIT
@@ -527,12 +554,19 @@ class HilBus(can.BusABC):
                 full_retry = True  # macOS: receiver full, no way to wait for room
             if self._closed:  # set before shutdown() wakes us, so checked after any drain
                 raise can.CanOperationError("hilbus: bus shut down during send")
+            if peer.overrun or _poll_ms(stall_deadline) == 0:
+                peer.overrun = True  # it has not read for member_stall_s: drop, as a CAN
+                self.overrun_drops += 1  # controller's full receive buffer does
+                return
             wait_ms = _poll_ms(deadline)
             if wait_ms == 0:
                 raise can.CanOperationError(
                     f"hilbus: send timed out: member {peer.name} on channel "
                     f"{self.channel!r} is not reading"
                 )
+            stall_ms = _poll_ms(stall_deadline)
+            if stall_ms is not None:
+                wait_ms = stall_ms if wait_ms is None else min(wait_ms, stall_ms)
             if full_retry:  # only our own socket can wake us: cap the wait
                 cap_ms = max(1, int(FULL_RETRY_S * 1000))
                 wait_ms = cap_ms if wait_ms is None else min(wait_ms, cap_ms)

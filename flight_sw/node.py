@@ -458,6 +458,8 @@ class FlightNode:
             ),
             "restarts": self.stats.restarts,
             "fdir": self._fdir_stats(),
+            # portable bus: frames not delivered to a member that stopped reading
+            "bus_overrun_drops": getattr(self.bus, "overrun_drops", 0),
         }
         tmp = self.stats_path.with_suffix(".tmp")
         tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")

@@ -589,3 +589,47 @@ def test_timestamp_is_the_arrival_not_the_read(pair: tuple[HilBus, HilBus]) -> N
     assert m is not None and m.tx_timestamp is not None
     assert m.tx_timestamp <= m.timestamp < m.tx_timestamp + READ_LATER_S / 2
     assert read_s - m.timestamp >= READ_LATER_S / 2
+
+
+STALL_S = 0.25  # member_stall_s of the sender in the overrun tests
+
+
+def _drain_all(bus: HilBus) -> list[can.Message]:
+    """Every frame queued for ``bus`` now (it has stopped receiving new ones)."""
+    got = []
+    while (m := bus.recv(timeout=0)) is not None:
+        got.append(m)
+    return got
+
+
+def test_member_that_stops_reading_is_overrun_while_others_get_every_frame(channel: str) -> None:
+    """A non-reading member holds the sender up once, then loses frames; the others lose none."""
+    with HilBus(channel, member_stall_s=STALL_S) as a, HilBus(channel) as b, \
+            HilBus(channel) as stuck:
+        collector = _Collector(b, QUEUE_OVERFILL_N)
+        collector.start()
+        t0 = time.monotonic()
+        for i in range(QUEUE_OVERFILL_N):
+            a.send(can.Message(arbitration_id=i))
+        # one stall, not one per frame (that would be QUEUE_OVERFILL_N * STALL_S = 50 s)
+        assert time.monotonic() - t0 < DEADLINE_S
+        assert [m.arbitration_id for m in collector.result()] == list(range(QUEUE_OVERFILL_N))
+        kept = _drain_all(stuck)
+        assert 0 < a.overrun_drops < QUEUE_OVERFILL_N
+        assert len(kept) + a.overrun_drops == QUEUE_OVERFILL_N  # each frame delivered or counted
+        ids = [m.arbitration_id for m in kept]
+        assert ids == sorted(ids) and ids[0] == 0  # the oldest were kept, in order
+        # it reads again: the next frame reaches it, and nothing more is dropped
+        a.send(can.Message(arbitration_id=0x7FF))
+        m = stuck.recv(timeout=DEADLINE_S)
+        assert m is not None and m.arbitration_id == 0x7FF
+        drops = a.overrun_drops
+        a.send(can.Message(arbitration_id=0x7FE))
+        assert a.overrun_drops == drops
+
+
+@pytest.mark.parametrize("bad", [-1.0, "soon", float("nan")])
+def test_bad_member_stall_is_refused(channel: str, bad: object) -> None:
+    """member_stall_s must be seconds >= 0 or None; the error names the value."""
+    with pytest.raises(BusError, match="member_stall_s"):
+        HilBus(channel, member_stall_s=bad)  # type: ignore[arg-type]

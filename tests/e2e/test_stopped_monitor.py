@@ -1,0 +1,52 @@
+"""A monitor that stops reading the portable bus cannot stop a run.
+
+A user watches a running bench with ``python -m can.logger -i hilbus`` and pauses it
+(Ctrl-Z, a full pipe): its queue fills. The run must still complete, lose nothing between
+bench and flight software, and report what the paused member missed.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.e2e.conftest import QUICKSTART, REPO, run_cli, unique_bus
+
+RUN_S = "2"
+LOGGER_READY_TIMEOUT_S = 60
+
+
+@pytest.mark.slow
+def test_paused_logger_does_not_stop_a_lockstep_run(tmp_path: Path, runtime_dir: Path) -> None:
+    """SIGSTOPped can.logger on the bus: the run completes, gap-free, and counts the drops."""
+    bus = unique_bus()
+    channel = bus.split(":", 1)[1]
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir), PYTHONUNBUFFERED="1")
+    logger = subprocess.Popen(
+        [sys.executable, "-m", "can.logger", "-i", "hilbus", "-c", channel],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=REPO, env=env,
+    )
+    try:
+        assert logger.stdout is not None
+        line = logger.stdout.readline()  # python-can prints the bus once it is open
+        assert "hilbus" in line or "Connected" in line, line
+        os.kill(logger.pid, signal.SIGSTOP)
+        r = run_cli(["run", str(QUICKSTART), "--bus", bus, "--duration", RUN_S],
+                    tmp_path / "run", runtime_dir)
+    finally:
+        os.kill(logger.pid, signal.SIGCONT)
+        logger.kill()
+        logger.communicate()
+    s = r.summary
+    assert "error" not in s, r.stderr
+    assert s["bus_overrun_drops"] > 0  # the bench's frames the paused logger missed
+    assert s["fsw"]["bus_overrun_drops"] > 0  # and the flight software's
+    assert any("stopped reading" in w for w in s["warnings"])
+    assert s["deadline_misses"]["stalls"] == 0
+    for name, f in s["frames"].items():
+        assert not f.get("gaps"), (name, f)
