@@ -789,10 +789,12 @@ class BenchNode:
             self.integrate_to(min(clock.now_ns(), end_ns) // STEP_NS * STEP_NS)
             wait_s = max(0.0, (self.plant.t_ns + STEP_NS - clock.now_ns()) / NS_PER_S)
             msg = self.bus.recv(timeout=wait_s)
-            for _ in range(RT_FRAMES_PER_PASS):
-                if msg is None or self.plant.t_ns >= end_ns:
-                    break
+            n_read = 0
+            while msg is not None:
                 self._on_realtime_frame(msg, clock)
+                n_read += 1
+                if n_read >= RT_FRAMES_PER_PASS or self.plant.t_ns >= end_ns:
+                    break  # back to stepping; the rest stays queued for the next pass
                 msg = self.bus.recv(timeout=0.0)
             if self.plant.t_ns >= next_progress:
                 self.trace.flush()

@@ -1,9 +1,11 @@
-"""A realtime bench slower than the wall clock still ends on time and keeps sending sensors.
+"""The realtime loop: it ends on time when slower than the wall clock, and loses no frame.
 
 An emulated or overloaded machine (the CI's QEMU guest) runs the plant slower than real
-time. The bench is driven here by a clock that runs ``CLOCK_SPEEDUP`` times faster than
+time. The bench is driven here by a clock that runs ``OVERLOAD_SPEEDUP`` times faster than
 the wall clock, so it cannot keep up, while a peer floods it with valid flight-software
-command frames, as a flight-software process on its own timer does.
+command frames, as a flight-software process on its own timer does. A second case keeps
+the wall clock and sends bursts far larger than the frames the loop reads per pass
+(``RT_FRAMES_PER_PASS``): every frame the bus hands the bench must still be handled.
 """
 
 from __future__ import annotations
@@ -11,10 +13,13 @@ from __future__ import annotations
 import threading
 import time
 import uuid
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from bench.node import NS_PER_S, BenchNode, Clock
+import can
+
+from bench.node import NS_PER_S, RT_FRAMES_PER_PASS, BenchNode, Clock
 from bench.plant import STEP_NS
 from bench.scenario import load_scenario
 from dbc import load_database
@@ -22,31 +27,50 @@ from dbc.bus import open_bus
 from dbc.codec import Encoder, cycle_time_ns
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
-CLOCK_SPEEDUP = 200  # the bench's clock against the wall clock: far beyond what it keeps up with
+OVERLOAD_SPEEDUP = 20  # the bench's clock against the wall clock: beyond what it keeps up with
 DURATION_S = 2.0  # of plant time
 PEER_GAP_S = 2e-4  # between the peer's frames: a stream the bench never drains by itself
-PEER_LIMIT_S = 60.0  # of wall time: the run must end within it, while the peer still floods
+PEER_LIMIT_S = 60.0  # of wall time: the run must end within it, while the peer still sends
 IMU_SHARE_MIN = 0.9  # of the IMU samples due in DURATION_S that must have been sent
+BURST_DURATION_S = 0.5  # of the wall-clock-paced case
+BURSTS = 3
+BURST_FRAMES = 4 * RT_FRAMES_PER_PASS  # frames per burst, sent back to back
+FIRST_FRAME = 1  # the boot heartbeat, read by wait_for_fsw before the loop starts
 
 
 @dataclass
-class FastClock(Clock):
-    """A bench clock running CLOCK_SPEEDUP times faster than the wall clock."""
+class ScaledClock(Clock):
+    """A bench clock running ``speedup`` times faster than the wall clock."""
+
+    speedup: int = 1
 
     def now_ns(self) -> int:
         """Scaled nanoseconds since the clock was made."""
-        return (time.monotonic_ns() - self.t0_ns) * CLOCK_SPEEDUP
+        return (time.monotonic_ns() - self.t0_ns) * self.speedup
 
 
-def _flood_commands(spec: str, stop: threading.Event, n_frames: int) -> None:
-    """Send FSW_STATUS, then THR_CMD_* frames (valves closed) until ``stop`` or the limit."""
+@dataclass
+class Counts:
+    """Frames the bus handed the bench, and frames the realtime loop handled."""
+
+    delivered: int = 0
+    handled: int = 0
+    sent: list[int] = field(default_factory=lambda: [0])
+
+
+def _status(enc: Encoder) -> can.Message:
+    return enc.message("FSW_STATUS", {
+        "Mode": 1, "Cycle": 0, "Overruns": 0, "FdirFlags": 0, "AllocSaturated": 0,
+        "AllocResidual": 0.0, "AllocForceResidual": 0.0})
+
+
+def _commands(spec: str, stop: threading.Event, n_frames: int, sent: list[int]) -> None:
+    """FSW_STATUS, then THR_CMD_* frames (valves closed) every PEER_GAP_S until ``stop``."""
     db = load_database()
     enc = Encoder(db)
     bus = open_bus(spec)
     try:
-        bus.send(enc.message("FSW_STATUS", {
-            "Mode": 1, "Cycle": 0, "Overruns": 0, "FdirFlags": 0, "AllocSaturated": 0,
-            "AllocResidual": 0.0, "AllocForceResidual": 0.0}))
+        bus.send(_status(enc))
         deadline = time.monotonic() + PEER_LIMIT_S
         cycle = 0
         while not stop.is_set() and time.monotonic() < deadline:
@@ -56,37 +80,83 @@ def _flood_commands(spec: str, stop: threading.Event, n_frames: int) -> None:
                 sig = {s.name: 0 for s in msg.signals if s.name not in ("CRC", "AliveCounter")}
                 sig["Cycle"] = cycle % 256
                 bus.send(enc.message(name, sig))
+                sent[0] += 1
                 stop.wait(PEER_GAP_S)
             cycle += 1
     finally:
         bus.shutdown()
 
 
-def test_overloaded_realtime_run_ends_at_its_duration(tmp_path: Path) -> None:
-    """A bench behind the wall clock ends at the run's duration with sensors sent throughout."""
-    sc = load_scenario(SCENARIO)
-    db = load_database()
-    spec = f"virtual:overload-{uuid.uuid4().hex}"
+def _bursts(spec: str, stop: threading.Event, n_frames: int, sent: list[int]) -> None:
+    """FSW_STATUS, then BURSTS bursts of BURST_FRAMES status frames, back to back."""
+    enc = Encoder(load_database())
     bus = open_bus(spec)
-    node = BenchNode(sc, db, bus, tmp_path, "realtime", 1, spec)
+    try:
+        bus.send(_status(enc))
+        for _ in range(BURSTS):
+            for _ in range(BURST_FRAMES):
+                bus.send(_status(enc))
+                sent[0] += 1
+            stop.wait(BURST_DURATION_S / (2 * BURSTS))
+    finally:
+        bus.shutdown()
+
+
+def _run(tmp_path: Path, duration_s: float, speedup: int,
+         peer: Callable[[str, threading.Event, int, list[int]], None]) -> tuple[BenchNode, Counts]:
+    """A realtime run of the quickstart against ``peer``; every frame read is counted."""
+    db = load_database()
+    spec = f"virtual:rt-{uuid.uuid4().hex}"
+    bus = open_bus(spec)
+    node = BenchNode(load_scenario(SCENARIO), db, bus, tmp_path, "realtime", 1, spec)
+    counts = Counts()
+    recv, on_frame = bus.recv, node._on_realtime_frame
+
+    def counting_recv(timeout: float | None = None) -> can.Message | None:
+        msg = recv(timeout=timeout)
+        counts.delivered += msg is not None
+        return msg
+
+    def counting_on_frame(msg: can.Message, clock: Clock) -> None:
+        counts.handled += 1
+        on_frame(msg, clock)
+
+    node.bus.recv = counting_recv  # type: ignore[method-assign]
+    node._on_realtime_frame = counting_on_frame  # type: ignore[method-assign]
     stop = threading.Event()
-    peer = threading.Thread(target=_flood_commands, args=(spec, stop, node.n_cmd_frames))
+    sender = threading.Thread(target=peer, args=(spec, stop, node.n_cmd_frames, counts.sent))
     # the run in a thread of its own, so that a bench that never ends fails the test
-    runner = threading.Thread(target=node.run_realtime, args=(DURATION_S, FastClock()),
-                              daemon=True)
-    peer.start()
+    runner = threading.Thread(target=node.run_realtime,
+                              args=(duration_s, ScaledClock(speedup=speedup)), daemon=True)
+    sender.start()
     runner.start()
     runner.join(PEER_LIMIT_S)
-    finished_while_flooded = not runner.is_alive() and peer.is_alive()
+    ended = not runner.is_alive()
     stop.set()
-    peer.join()
-    assert finished_while_flooded, f"the realtime run did not end within {PEER_LIMIT_S} s"
+    sender.join()
+    assert ended, f"the realtime run did not end within {PEER_LIMIT_S} s"
     bus.shutdown()
+    return node, counts
+
+
+def test_overloaded_realtime_run_ends_at_its_duration(tmp_path: Path) -> None:
+    """A bench behind the wall clock ends at the run's duration with sensors sent throughout."""
+    node, counts = _run(tmp_path, DURATION_S, OVERLOAD_SPEEDUP, _commands)
     summary = node.close(DURATION_S)
     end_ns = round(DURATION_S * NS_PER_S)
     assert end_ns <= node.plant.t_ns < end_ns + STEP_NS
-    imu_due = DURATION_S * NS_PER_S / cycle_time_ns(db, "IMU_RATE")
+    imu_due = DURATION_S * NS_PER_S / cycle_time_ns(node.db, "IMU_RATE")
     assert node.sent["IMU_RATE"] >= IMU_SHARE_MIN * imu_due
+    assert counts.delivered == counts.handled + FIRST_FRAME  # no frame read, then dropped
     misses = summary["deadline_misses"]
     assert misses["bench_late"] > 0
     assert misses["bench_max_lag_ms"] > node.period_ns / 1e6
+
+
+def test_bursts_beyond_a_pass_are_all_handled(tmp_path: Path) -> None:
+    """Bursts of several passes' worth of frames: each frame read is handled, none lost."""
+    node, counts = _run(tmp_path, BURST_DURATION_S, 1, _bursts)
+    node.close(BURST_DURATION_S)
+    assert counts.sent[0] == BURSTS * BURST_FRAMES
+    assert counts.delivered == counts.handled + FIRST_FRAME
+    assert counts.handled >= counts.sent[0]  # every burst frame (and the heartbeat) handled
