@@ -27,9 +27,12 @@ end of the run), a ``kind`` and its target and parameters:
 - ``babbling`` (``can_id``, ``rate_hz``): a babbling node floods the bus with random 8-byte
   frames of that (typically high-priority, unknown) ID at that rate.
 
-Bus faults act on the modelled bus, so in lockstep runs only (a realtime run records them
-as not applicable). Targets are checked against the scenario's thrusters and the DBC's
-messages and nodes. Pure data; the bench node applies them.
+Bus faults act on the modelled bus in lockstep runs. In realtime, where there is no
+modelled bus, ``drop``, ``corrupt`` and ``duplicate`` (:data:`REALTIME_BUS_KINDS`) still act
+on the frames the bench sends and receives; the others (``delay``, ``link_error``,
+``bus_off``, ``babbling``) are recorded as not applied and have no effect. Targets are
+checked against the scenario's thrusters and the DBC's messages and nodes. Pure data; the
+bench node applies them.
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ BIAS_JUMP_PARAM = {"gyro": "jump_rad_s", "accelerometer": "jump_m_s2",
                    "star_tracker": "misalignment_arcsec"}
 FRAME_KINDS = ("link_error", "drop", "delay", "corrupt", "duplicate")
 BUS_KINDS = (*FRAME_KINDS, "bus_off", "babbling")
+REALTIME_BUS_KINDS = frozenset({"drop", "corrupt", "duplicate"})  # need no modelled bus
 MAX_STD_ID = 0x7FF
 MAX_RATE_HZ = 20_000.0  # above a 1 Mbit/s bus's capacity for 8-byte frames
 FAULT_KINDS = THRUSTER_KINDS + BUS_KINDS + SENSOR_KINDS

@@ -30,7 +30,14 @@ import numpy as np
 from cantools.database.can import Database
 
 from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_time_ns
-from bench.faults import BUS_KINDS, NO_FATE, FaultSpec, fault_from_command, frame_fate
+from bench.faults import (
+    BUS_KINDS,
+    NO_FATE,
+    REALTIME_BUS_KINDS,
+    FaultSpec,
+    fault_from_command,
+    frame_fate,
+)
 from bench.metrics import expectation, latency_summary, pointing_metrics, settling_time_s
 from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
@@ -350,10 +357,14 @@ class BenchNode:
     def _start_fault(self, f: FaultSpec, t_ns: int, end_ns: int | None,
                      source: str = "scenario") -> None:
         rec = {**f.record(), "t_s": t_ns / NS_PER_S, "source": source}
-        if f.kind in BUS_KINDS and self.mode != "lockstep":
+        if f.kind in BUS_KINDS and self.mode != "lockstep" and f.kind not in REALTIME_BUS_KINDS:
             rec["applied"] = False
-            rec["why"] = "bus faults act on the modelled bus (lockstep runs only)"
-        elif f.thruster is not None:
+            rec["why"] = (f"{f.kind} acts on the modelled bus (lockstep runs only); in "
+                          f"realtime only {', '.join(sorted(REALTIME_BUS_KINDS))} apply")
+            self.faults_log.append(rec)
+            self.trace.event(t_ns, "fault_injected", **rec)
+            return
+        if f.thruster is not None:
             self.plant.thrusters.set_fault(f.thruster, f.kind, t_ns, **f.params)
         elif f.sensor is not None:
             self._sensor(f.sensor).set_fault(f.kind, t_ns, **f.params)
@@ -642,6 +653,7 @@ class BenchNode:
         self.wait_for_fsw()
         self.trace.event(0, "run_started", mode=self.mode, seed=self.seed, cycles=n_cycles)
         wall0 = time.monotonic()
+        self._faults_due(0)  # a fault at t = 0 acts on the first samples too
         self._queue_due(0)
         self._telemetry_row(0)
         for k in range(n_cycles):
@@ -766,9 +778,10 @@ class BenchNode:
         A bench slower than the wall clock (an overloaded or emulated machine) still ends
         at ``duration_s`` of plant time: each pass steps the plant to the clock, then reads
         at most ``RT_FRAMES_PER_PASS`` frames, so neither catching up nor a stream of
-        frames can keep it from sending sensors or from ending. Every pass that starts
-        more than a control period behind is counted (``bench_late``) and the largest lag
-        is reported (``bench_max_lag_ms``): such a run's timing figures are not real time.
+        frames can keep it from sending sensors or from ending. Every pass, and every
+        command frame, that finds the plant more than a control period behind the clock is
+        counted (``bench_late``) and the largest lag is reported (``bench_max_lag_ms``):
+        such a run's timing figures are not real time.
         """
         self.wait_for_fsw()
         self.trace.event(0, "run_started", mode=self.mode, seed=self.seed)
@@ -776,16 +789,14 @@ class BenchNode:
         self.wall_origin_s = clock.wall0_s
         end_ns = round(duration_s * NS_PER_S)
         self._rt_end_ns = end_ns
+        self._faults_due(0)  # a fault at t = 0 acts on the first samples too
         self._queue_due(0)
         self._telemetry_row(0)
         self._send_queue(realtime_ns=clock.now_ns())
         self._rt_clock = clock
         next_progress = 0
         while self.plant.t_ns < end_ns:
-            lag_ns = clock.now_ns() - self.plant.t_ns
-            self.max_lag_ns = max(self.max_lag_ns, lag_ns)
-            if lag_ns > self.period_ns:
-                self.late_steps += 1
+            self._note_lag(clock.now_ns())
             self.integrate_to(min(clock.now_ns(), end_ns) // STEP_NS * STEP_NS)
             wait_s = max(0.0, (self.plant.t_ns + STEP_NS - clock.now_ns()) / NS_PER_S)
             msg = self.bus.recv(timeout=wait_s)
@@ -809,7 +820,31 @@ class BenchNode:
         self.trace.event(self.plant.t_ns, "run_finished", late_steps=self.late_steps,
                          max_lag_ms=self.max_lag_ns / 1e6)
 
+    def _note_lag(self, now_ns: int) -> None:
+        """Realtime: how far the plant is behind the clock before it catches up."""
+        lag_ns = now_ns - self.plant.t_ns
+        self.max_lag_ns = max(self.max_lag_ns, lag_ns)
+        if lag_ns > self.period_ns:
+            self.late_steps += 1
+
     def _on_realtime_frame(self, msg: can.Message, clock: Clock) -> None:
+        """A frame read in realtime: the active drop/corrupt/duplicate faults, then its effect."""
+        name = self.name_of.get(msg.arbitration_id)
+        if self.active_faults and name is not None and self.sender_of[name] != BENCH_NODE:
+            fate = frame_fate(self.active_faults_specs, name, self.sender_of[name],
+                              self.fault_rng)
+            if fate.drop:
+                self.fault_counts["dropped"] += 1
+                return
+            if fate.corrupt_bit is not None:
+                self.fault_counts["corrupted"] += 1
+                _flip(msg, fate.corrupt_bit)
+            if fate.duplicate:
+                self.fault_counts["duplicated"] += 1
+                self._realtime_frame(msg, clock)
+        self._realtime_frame(msg, clock)
+
+    def _realtime_frame(self, msg: can.Message, clock: Clock) -> None:
         t_ns = clock.now_ns()
         d = self.checker.check(msg)
         if d is None:
@@ -823,6 +858,7 @@ class BenchNode:
         )
         s: dict[str, float] = d.signals
         if d.name.startswith("THR_CMD_"):
+            self._note_lag(t_ns)
             self.integrate_to(min(self._rt_end_ns, max(self.plant.t_ns, t_ns // STEP_NS * STEP_NS)))
             t_apply = max(t_ns, self.plant.t_ns)
             index = int(d.name[-1])

@@ -1,11 +1,13 @@
-"""The realtime loop: it ends on time when slower than the wall clock, and loses no frame.
+"""The realtime loop: it ends on time when slower than the wall clock, loses no frame, and
+applies the bus faults that need no modelled bus.
 
 An emulated or overloaded machine (the CI's QEMU guest) runs the plant slower than real
 time. The bench is driven here by a clock that runs ``OVERLOAD_SPEEDUP`` times faster than
 the wall clock, so it cannot keep up, while a peer floods it with valid flight-software
 command frames, as a flight-software process on its own timer does. A second case keeps
 the wall clock and sends bursts far larger than the frames the loop reads per pass
-(``RT_FRAMES_PER_PASS``): every frame the bus hands the bench must still be handled.
+(``RT_FRAMES_PER_PASS``): every frame the bus hands the bench must still be handled. The
+last cases inject ``drop`` both ways and a ``delay`` (modelled bus only) in realtime.
 """
 
 from __future__ import annotations
@@ -103,12 +105,13 @@ def _bursts(spec: str, stop: threading.Event, n_frames: int, sent: list[int]) ->
 
 
 def _run(tmp_path: Path, duration_s: float, speedup: int,
-         peer: Callable[[str, threading.Event, int, list[int]], None]) -> tuple[BenchNode, Counts]:
+         peer: Callable[[str, threading.Event, int, list[int]], None],
+         overrides: list[str] | None = None) -> tuple[BenchNode, Counts]:
     """A realtime run of the quickstart against ``peer``; every frame read is counted."""
     db = load_database()
     spec = f"virtual:rt-{uuid.uuid4().hex}"
     bus = open_bus(spec)
-    node = BenchNode(load_scenario(SCENARIO), db, bus, tmp_path, "realtime", 1, spec)
+    node = BenchNode(load_scenario(SCENARIO, overrides), db, bus, tmp_path, "realtime", 1, spec)
     counts = Counts()
     recv, on_frame = bus.recv, node._on_realtime_frame
 
@@ -160,3 +163,67 @@ def test_bursts_beyond_a_pass_are_all_handled(tmp_path: Path) -> None:
     assert counts.sent[0] == BURSTS * BURST_FRAMES
     assert counts.delivered == counts.handled + FIRST_FRAME
     assert counts.handled >= counts.sent[0]  # every burst frame (and the heartbeat) handled
+
+
+def _fault(kind: str, target: str, extra: str = "") -> list[str]:
+    return [f'faults=[{{t_s = 0.0, kind = "{kind}", {target}, probability = 1.0{extra}}}]']
+
+
+def test_drop_in_realtime_acts_on_received_frames(tmp_path: Path) -> None:
+    """drop FSW_STATUS (p = 1): every status frame read during the run is dropped, counted."""
+    node, counts = _run(tmp_path, BURST_DURATION_S, 1, _bursts,
+                        _fault("drop", 'message = "FSW_STATUS"'))
+    summary = node.close(BURST_DURATION_S)
+    assert summary["faults"][0].get("applied", True)
+    assert summary["fault_effects"]["dropped"] == counts.handled == BURSTS * BURST_FRAMES
+    assert summary["frames"]["FSW_STATUS"]["received"] == FIRST_FRAME  # the boot heartbeat
+
+
+def test_drop_in_realtime_acts_on_sent_frames(tmp_path: Path) -> None:
+    """drop IMU_RATE (p = 1): the bench sends none, and counts each one dropped."""
+    node, _ = _run(tmp_path, BURST_DURATION_S, 1, _bursts, _fault("drop", 'message = "IMU_RATE"'))
+    summary = node.close(BURST_DURATION_S)
+    imu_due = BURST_DURATION_S * NS_PER_S / cycle_time_ns(node.db, "IMU_RATE")
+    assert node.sent.get("IMU_RATE", 0) == 0
+    assert summary["fault_effects"]["dropped"] >= IMU_SHARE_MIN * imu_due
+
+
+def test_delay_in_realtime_is_recorded_as_not_applied(tmp_path: Path) -> None:
+    """delay needs the modelled bus: recorded with applied = false and why, no effect."""
+    node, _ = _run(tmp_path, BURST_DURATION_S, 1, _bursts,
+                   _fault("delay", 'message = "IMU_RATE"', ", delay_s = 0.01"))
+    summary = node.close(BURST_DURATION_S)
+    rec = summary["faults"][0]
+    assert rec["applied"] is False and "lockstep" in rec["why"]
+    assert summary["fault_effects"]["delayed"] == 0
+    assert node.sent["IMU_RATE"] > 0
+
+
+
+STALL_NS = 130_000_000  # 6.5 control periods
+
+
+@dataclass
+class FixedClock(Clock):
+    """A clock that reads ``at_ns`` (no wall clock)."""
+
+    at_ns: int = 0
+
+    def now_ns(self) -> int:
+        """The fixed reading."""
+        return self.at_ns
+
+
+def test_a_command_that_finds_the_plant_behind_counts_it_late(tmp_path: Path) -> None:
+    """A command frame arriving 130 ms after the plant's time: counted before it catches up."""
+    db = load_database()
+    spec = f"virtual:rt-{uuid.uuid4().hex}"
+    bus = open_bus(spec)
+    node = BenchNode(load_scenario(SCENARIO), db, bus, tmp_path, "realtime", 1, spec)
+    msg = db.get_message_by_name("THR_CMD_0")
+    sig = {s.name: 0 for s in msg.signals if s.name not in ("CRC", "AliveCounter")}
+    node._on_realtime_frame(Encoder(db).message("THR_CMD_0", sig), FixedClock(at_ns=STALL_NS))
+    bus.shutdown()
+    misses = node.close(0.0)["deadline_misses"]
+    assert misses["bench_late"] == 1
+    assert misses["bench_max_lag_ms"] == STALL_NS / 1e6
