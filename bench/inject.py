@@ -18,7 +18,7 @@ from bench.faults import FAULT_CMD_KINDS
 from dbc import e2e, load_database
 from dbc.bus import open_bus
 from dbc.codec import Encoder, FrameChecker
-from dbc.errors import RunError
+from dbc.errors import ConfigError, RunError
 
 COUNTER_NONE = 15
 DEFAULT_TIMEOUT_S = 5.0
@@ -37,7 +37,8 @@ class FaultCommand:
 
     def __post_init__(self) -> None:
         if self.kind not in KIND_CODES:
-            raise RunError(f"fault kind {self.kind!r}: expected one of {', '.join(KIND_CODES)}")
+            raise ConfigError("thruster-hil inject", "kind", self.kind,
+                              f"one of {', '.join(KIND_CODES)}")
 
     def signals(self) -> dict[str, float | int]:
         """FAULT_CMD signal values."""

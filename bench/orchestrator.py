@@ -38,14 +38,16 @@ from bench.scenario import Scenario
 from dbc import load_database
 from dbc.bus import open_bus
 from dbc.codec import cycle_time_ns
-from dbc.errors import ConfigError, RunError
+from dbc.errors import ConfigError, RefusedConfigError, RunError
 
 DEFAULT_FSW_CMD = (
     f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
     "--config {config} --stats {stats} --rx-log {rx_log}"
 )
 FSW_TERM_TIMEOUT_S = 5.0
-EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH = 0, 3, 4
+EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH, EXIT_CHILD_BAD_INPUT = 0, 3, 4, 5
+FSW_EXIT_BAD_INPUT = 2  # our flight software's exit code for a configuration it refuses
+FSW_ERROR_MARK = "error:"  # how its refusal line reads in fsw.log
 PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
 
@@ -137,6 +139,8 @@ def run_scenario(
             signal.signal(signal.SIGTERM, _terminate)
             (out / "bench.pid").write_text(f"{os.getpid()}\n", encoding="utf-8")
             _run_bench(sc, opts, progress, ready, config)
+        except ConfigError:
+            code = EXIT_CHILD_BAD_INPUT
         except RunError:
             code = EXIT_CHILD_RUN_ERROR
         except BaseException:
@@ -154,8 +158,11 @@ def run_scenario(
         summary = partial_summary(sc, opts, f"bench process killed by signal {os.WTERMSIG(status)}")
         raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    if os.WEXITSTATUS(status) == EXIT_CHILD_BAD_INPUT:
+        raise RefusedConfigError("the flight software", summary["fsw"]["refused"])
     if os.WEXITSTATUS(status) != EXIT_CHILD_OK:
-        raise RunError(f"run failed ({summary.get('error')}); run folder: {out}")
+        tail = "".join(f"\n  fsw.log: {x}" for x in (summary.get("fsw") or {}).get("log_tail", []))
+        raise RunError(f"run failed ({summary.get('error')}); run folder: {out}{tail}")
     return summary
 
 
@@ -211,25 +218,35 @@ def _run_bench(
             v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns")
         )
     summary["warnings"] = bus_warnings(summary["frames"])
-    # hilbus: frames the bench could not deliver to a member that stopped reading
-    drops = getattr(bus, "overrun_drops", 0)
-    summary["bus_overrun_drops"] = drops
-    if drops:
+    # hilbus: frames the bench and the flight software could not deliver to a member that
+    # stopped reading (each process counts its own)
+    bench_drops = getattr(bus, "overrun_drops", 0)
+    fsw_drops = int(summary["fsw"].get("bus_overrun_drops", 0) or 0)
+    summary["bus_overrun_drops"] = bench_drops + fsw_drops
+    if bench_drops + fsw_drops:
         summary["warnings"].append(
-            f"{drops} bench frames were dropped for a bus member that stopped reading "
-            "(e.g. a paused can.logger); the flight software was not affected unless it "
-            "was that member")
+            f"{bench_drops} bench and {fsw_drops} flight-software frames were dropped for a "
+            "bus member that stopped reading (e.g. a paused can.logger); bench and flight "
+            "software lost nothing unless one of them was that member")
     if any("another node" in w for w in summary["warnings"]):
         summary["passed"] = False
     if error is not None:
         summary["error"] = f"{type(error).__name__}: {error}"
         if "first frame" in str(error):
             summary["fsw"]["log_tail"] = _log_tail(out / "fsw.log")
+            refusal = [x for x in summary["fsw"]["log_tail"] if FSW_ERROR_MARK in x]
+            if fsw_rc == FSW_EXIT_BAD_INPUT and refusal:
+                summary["fsw"]["refused"] = refusal[-1].split(FSW_ERROR_MARK, 1)[1].strip()
+                summary["error"] = f"the flight software refused its configuration: " \
+                                   f"{summary['fsw']['refused']}"
+                error = RefusedConfigError("the flight software", summary["fsw"]["refused"])
         summary["passed"] = False
     write_summary(out / "summary.json", summary)
     plot_run(out, sc.expectations.settling_band_deg)
     if error is not None and not isinstance(error, Exception):
         raise error  # KeyboardInterrupt and friends, after the folder is complete
+    if isinstance(error, RefusedConfigError):
+        raise error
     if error is not None:
         tail = "".join(f"\n  fsw.log: {x}" for x in summary["fsw"].get("log_tail", []))
         raise RunError(f"run failed ({summary['error']}); run folder: {out}{tail}") from error

@@ -2,6 +2,7 @@
 
     ThrusterHilError            base of every error this project raises on purpose
     ├── ConfigError             a scenario or configuration value is wrong (file, key, value)
+    │   └── RefusedConfigError  another process refused its configuration (its own message)
     ├── IcdError                the DBC is unusable or a frame cannot be encoded from it
     ├── BusError                a bus spec is wrong or a bus cannot be opened / used
     └── RunError                a run could not start or complete (a process failed, a stall)
@@ -26,6 +27,17 @@ class ConfigError(ThrusterHilError, ValueError):
         self.value = value
         self.expected = expected
         super().__init__(f"{source}: {key} = {value!r}: expected {expected}")
+
+
+class RefusedConfigError(ConfigError):
+    """A child process (the flight software) refused its configuration and said why.
+
+    ``message`` is the process's own error line, which names the file, key and value.
+    """
+
+    def __init__(self, who: str, message: str) -> None:
+        self.source, self.key, self.value, self.expected = who, "", None, message
+        ValueError.__init__(self, f"{who} refused its configuration: {message}")
 
 
 class IcdError(ThrusterHilError):

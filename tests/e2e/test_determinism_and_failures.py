@@ -89,6 +89,16 @@ def test_bad_scenario_names_file_key_and_value(tmp_path: Path, runtime_dir: Path
     assert str(bad) in r.stderr and "thrusters.max_thrust_N" in r.stderr and "-15.0" in r.stderr
 
 
+def test_bad_flight_software_value_names_key_and_value(tmp_path: Path, runtime_dir: Path) -> None:
+    """A [flight_sw] value only the flight software checks: exit 2 with its key and value."""
+    r = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", "1",
+                 "--set", 'flight_sw.modulator.kind="pwfp"'], tmp_path / "run", runtime_dir)
+    assert r.returncode == EXIT_BAD_INPUT, r.stderr
+    assert "refused its configuration" in r.stderr
+    assert "flight_sw.modulator.kind" in r.stderr and "'pwfp'" in r.stderr
+    assert (tmp_path / "run" / "fsw.log").exists()  # the run folder still says what happened
+
+
 def test_realtime_run_measures_latency(tmp_path: Path, runtime_dir: Path) -> None:
     """A short realtime run reports measured sensor-to-command latency and deadline counters."""
     r = run_cli(
