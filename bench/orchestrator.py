@@ -154,6 +154,7 @@ def run_scenario(
         _, status = os.waitpid(pid, 0)
     finally:
         signal.signal(signal.SIGINT, previous)
+    (out / "bench.pid").unlink(missing_ok=True)  # a pid file names a running process only
     if os.WIFSIGNALED(status):
         summary = partial_summary(sc, opts, f"bench process killed by signal {os.WTERMSIG(status)}")
         raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
@@ -205,6 +206,7 @@ def _run_bench(
         error = exc
     finally:
         fsw_rc = _stop(proc) if proc is not None else None
+        (out / "fsw.pid").unlink(missing_ok=True)
         bus.shutdown()
     summary = node.close(opts.duration_s if error is None else node.plant.t_ns / 1e9)
     summary["fsw"] = _fsw_report(stats, fsw_rc, out)
@@ -217,7 +219,7 @@ def _run_bench(
         summary["deadline_misses"]["total"] = sum(
             v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns")
         )
-    summary["warnings"] = bus_warnings(summary["frames"])
+    summary["warnings"] = bus_warnings(summary["frames"]) + duration_warnings(sc, opts.duration_s)
     # hilbus: frames the bench and the flight software could not deliver to a member that
     # stopped reading (each process counts its own)
     bench_drops = getattr(bus, "overrun_drops", 0)
@@ -251,6 +253,24 @@ def _run_bench(
         tail = "".join(f"\n  fsw.log: {x}" for x in summary["fsw"].get("log_tail", []))
         raise RunError(f"run failed ({summary['error']}); run folder: {out}{tail}") from error
     return summary
+
+
+def duration_warnings(sc: Scenario, duration_s: float) -> list[str]:
+    """A run too short for its own expectations: the steady-state window holds the transient.
+
+    The window is the last ``steady_state_window_s`` of the run; it should start after the
+    manoeuvre's start plus its allowed settling time.
+    """
+    e = sc.expectations
+    settled_s = sc.manoeuvre_start_s + (e.settling_time_s_max or 0.0)
+    window_start_s = duration_s - e.steady_state_window_s
+    if window_start_s >= settled_s:
+        return []
+    return [f"the run is {duration_s:g} s: its steady-state window (the last "
+            f"{e.steady_state_window_s:g} s) starts before the manoeuvre may have settled "
+            f"({settled_s:g} s), so steady-state figures include the transient; run at least "
+            f"{settled_s + e.steady_state_window_s:g} s (the scenario's own duration is "
+            f"{sc.duration_s:g} s)"]
 
 
 def bus_warnings(frames: dict[str, dict[str, Any]]) -> list[str]:
