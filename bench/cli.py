@@ -215,7 +215,9 @@ def build_parser() -> argparse.ArgumentParser:
     inj.add_argument("--target", type=lambda x: int(x, 0), required=True,
                      help="thruster index, sensor index (0 gyro, 1 accelerometer, 2 star "
                      "tracker), message CAN ID (e.g. 0x40) or node index (0 BENCH, 1 FSW)")
-    inj.add_argument("--duration", type=float, default=0.0, help="seconds; 0 = until cleared")
+    inj.add_argument("--duration", type=float, default=0.0,
+                     help="seconds of the bench's time (simulated in lockstep, wall clock in "
+                     "realtime); 0 = until cleared")
     inj.add_argument("--param", type=float, default=0.0,
                      help="the kind's parameter (factor, probability, delay s, ...)")
     inj.add_argument("--clear", action="store_true", help="clear the fault instead")
