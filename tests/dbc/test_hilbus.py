@@ -162,6 +162,20 @@ class _Lines:
             self._q.put(line)
         self._q.put(None)
 
+    def rest(self, deadline_s: float = DEADLINE_S) -> list[str]:
+        """Every line until EOF (or the deadline)."""
+        deadline = time.monotonic() + deadline_s
+        out: list[str] = []
+        while (left := deadline - time.monotonic()) > 0:
+            try:
+                line = self._q.get(timeout=left)
+            except queue.Empty:
+                break
+            if line is None:
+                break
+            out.append(line)
+        return out
+
     def wait_for(self, predicate_text: str, deadline_s: float = DEADLINE_S) -> str:
         """The first line containing predicate_text; fails at EOF or the deadline."""
         deadline = time.monotonic() + deadline_s
@@ -552,7 +566,7 @@ def test_can_logger_prints_frames(runtime: Path, channel: str) -> None:
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
-        env=_env(runtime),
+        env={**_env(runtime), "PYTHONFAULTHANDLER": "1"},  # SIGABRT dumps its stacks
         cwd=runtime,
     ) as logger:
         try:
@@ -567,7 +581,12 @@ def test_can_logger_prints_frames(runtime: Path, channel: str) -> None:
             assert "123" in first and "ca fe" in first and channel in first
             assert "1badbee" in second.lower() and "01 02 03" in second
             logger.send_signal(signal.SIGINT)  # can.logger shuts the bus down on Ctrl-C
-            logger.wait(DEADLINE_S)
+            try:
+                logger.wait(DEADLINE_S)
+            except subprocess.TimeoutExpired:
+                logger.send_signal(signal.SIGABRT)  # where is it stuck? (faulthandler)
+                pytest.fail("can.logger ignored Ctrl-C for "
+                            f"{DEADLINE_S} s; its stacks:\n{''.join(lines.rest())}")
         finally:
             if logger.poll() is None:
                 logger.kill()
