@@ -586,7 +586,8 @@ class HilBus(can.BusABC):
                 self._wake_self()
 
     def _drain_locked(self) -> None:
-        while True:
+        # after shutdown() the socket reads as end-of-file (empty records) for ever: stop
+        while not self._closed:
             try:
                 record, rx_time = self._recv_record()
             except BlockingIOError:

@@ -568,6 +568,9 @@ def test_can_logger_prints_frames(runtime: Path, channel: str) -> None:
         text=True,
         env={**_env(runtime), "PYTHONFAULTHANDLER": "1"},  # SIGABRT dumps its stacks
         cwd=runtime,
+        # Ctrl-C reaches it as from a terminal, even when this run's SIGINT is ignored (a
+        # background job inherits SIG_IGN, and so would the logger: seen in CI)
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     ) as logger:
         try:
             assert logger.stdout is not None
