@@ -236,9 +236,14 @@ def _run_bench(
         summary["error"] = f"{type(error).__name__}: {error}"
         if "first frame" in str(error):
             summary["fsw"]["log_tail"] = _log_tail(out / "fsw.log")
-            refusal = [x for x in summary["fsw"]["log_tail"] if FSW_ERROR_MARK in x]
+            # ours writes its reason to the statistics file; another flight software's last
+            # "error:" line in its log is taken for it
+            refusal = [x.split(FSW_ERROR_MARK, 1)[1].strip()
+                       for x in summary["fsw"]["log_tail"] if FSW_ERROR_MARK in x]
+            if summary["fsw"].get("refused"):
+                refusal.append(summary["fsw"]["refused"])
             if fsw_rc == FSW_EXIT_BAD_INPUT and refusal:
-                summary["fsw"]["refused"] = refusal[-1].split(FSW_ERROR_MARK, 1)[1].strip()
+                summary["fsw"]["refused"] = refusal[-1]
                 summary["error"] = f"the flight software refused its configuration: " \
                                    f"{summary['fsw']['refused']}"
                 error = RefusedConfigError("the flight software", summary["fsw"]["refused"])
@@ -256,21 +261,32 @@ def _run_bench(
 
 
 def duration_warnings(sc: Scenario, duration_s: float) -> list[str]:
-    """A run too short for its own expectations: the steady-state window holds the transient.
+    """A run too short for its scenario: the steady-state window holds the transient.
 
     The window is the last ``steady_state_window_s`` of the run; it should start after the
     manoeuvre's start plus its allowed settling time.
+
+    Also: scheduled faults and events that a shortened run (``--duration``) ends before;
+    they never act, and the run's figures are those of a run without them.
     """
+    out: list[str] = []
     e = sc.expectations
     settled_s = sc.manoeuvre_start_s + (e.settling_time_s_max or 0.0)
     window_start_s = duration_s - e.steady_state_window_s
-    if window_start_s >= settled_s:
-        return []
-    return [f"the run is {duration_s:g} s: its steady-state window (the last "
-            f"{e.steady_state_window_s:g} s) starts before the manoeuvre may have settled "
-            f"({settled_s:g} s), so steady-state figures include the transient; run at least "
-            f"{settled_s + e.steady_state_window_s:g} s (the scenario's own duration is "
-            f"{sc.duration_s:g} s)"]
+    if window_start_s < settled_s:
+        out.append(f"the run is {duration_s:g} s: its steady-state window (the last "
+                   f"{e.steady_state_window_s:g} s) starts before the manoeuvre may have "
+                   f"settled ({settled_s:g} s), so steady-state figures include the transient; "
+                   f"run at least {settled_s + e.steady_state_window_s:g} s (the scenario's "
+                   f"own duration is {sc.duration_s:g} s)")
+    for kind, items in (("[[faults]]", sc.faults), ("[[events]]", sc.events)):
+        late = [x for x in items if x.t_s >= duration_s]
+        if late:
+            what = ", ".join(
+                f"{getattr(x, 'kind', 'capture')} at {x.t_s:g} s" for x in late)
+            out.append(f"the run is {duration_s:g} s: {len(late)} of the scenario's {kind} "
+                       f"never act ({what}); run longer than {max(x.t_s for x in late):g} s")
+    return out
 
 
 def bus_warnings(frames: dict[str, dict[str, Any]]) -> list[str]:

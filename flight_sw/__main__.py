@@ -3,13 +3,16 @@
 Opens the bus, builds the flight computer from ``--config`` and runs it in lockstep (one
 cycle per SYNC) or realtime (own timer) until SIGTERM/SIGINT. ``--check`` only validates
 the configuration. ``--rx-log`` (realtime) logs when each frame arrived
-(:mod:`flight_sw.rx_log`). Exit codes: 0 ok, 2 bad configuration, bus or log path.
+(:mod:`flight_sw.rx_log`). Exit codes: 0 ok, 2 bad configuration, bus or log path (and
+the reason, as ``{"refused": ...}``, in the ``--stats`` file).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
+import json
 import sys
 from pathlib import Path
 
@@ -22,6 +25,13 @@ from flight_sw.node import FlightNode
 from flight_sw.rx_log import ReceiveLog
 
 EXIT_BAD_INPUT = 2
+
+
+def _write_refusal(stats: str | None, why: str) -> None:
+    """``{"refused": why}`` as the statistics file: the bench reports it instead of a crash."""
+    if stats:
+        with contextlib.suppress(OSError):  # the message is on stderr as well
+            Path(stats).write_text(json.dumps({"refused": why}) + "\n", encoding="utf-8")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -54,6 +64,7 @@ def main(argv: list[str] | None = None) -> int:
         bus = open_bus(args.bus or default_bus_spec())
     except (ConfigError, BusError) as exc:
         print(f"flight_sw: error: {exc}", file=sys.stderr)
+        _write_refusal(args.stats, str(exc))
         return EXIT_BAD_INPUT
     try:
         rx_log = ReceiveLog(Path(args.rx_log)) if args.rx_log and args.mode == "realtime" else None

@@ -44,7 +44,13 @@ from flight_sw.fdir.base import NO_THRUSTER
 from flight_sw.rx_log import ReceiveLog
 
 THRUSTERS_PER_CMD_FRAME = 4
-HEARTBEAT_RETRY_S = 1.0
+HEARTBEAT_RETRY_S = 1.0  # silence before the next FSW_STATUS heartbeat, until the first SYNC
+# Lockstep, once cycling: the bench is the time master and may be silent for a while without
+# being gone (paused in a debugger; its send held up to hilbus.MEMBER_STALL_S = 1 s by a
+# stopped bus monitor). A heartbeat then would put a wall-clock-timed frame into the
+# deterministic trace and shift FSW_STATUS's alive counter. A restarted bench waits for the
+# heartbeat up to its startup timeout (60 s by default), so a longer silence is harmless.
+LOCKSTEP_SILENCE_HEARTBEAT_S = 5.0
 CYCLE_MODULUS = 256
 STATUS_CYCLE_MODULUS = 65536
 OVERRUN_MAX = 255
@@ -139,6 +145,7 @@ class FlightNode:
         self.period_ns = cycle_time_ns(db, "THR_CMD_0")
         self.status_every = max(1, cycle_time_ns(db, "FSW_STATUS") // self.period_ns)
         self._stop = False
+        self.lockstep_silence_heartbeat_s = LOCKSTEP_SILENCE_HEARTBEAT_S
         self._last_sync: int | None = None
         self._pending_seen: set[str] = set()
         self._sync_cycle = -1
@@ -333,7 +340,8 @@ class FlightNode:
         """FSW_STATUS alone: BOOT before the first cycle, else the current state.
 
         Sent at start-up and after every second without any frame (before the first SYNC,
-        or when the bench has gone: a restarted bench waits for this frame to start).
+        or when the bench has gone: a restarted bench waits for this frame to start); in
+        lockstep once cycling, after ``LOCKSTEP_SILENCE_HEARTBEAT_S`` without any frame.
         """
         self._send("FSW_STATUS", self._status_signals(self.stats.cycles))
 
@@ -342,7 +350,9 @@ class FlightNode:
         """Cycle on SYNC frames until stopped."""
         self._heartbeat()
         while not self._stop:
-            msg = self.bus.recv(timeout=HEARTBEAT_RETRY_S)
+            silence_s = (HEARTBEAT_RETRY_S if self._last_sync is None
+                         else self.lockstep_silence_heartbeat_s)
+            msg = self.bus.recv(timeout=silence_s)
             if msg is None:
                 self._heartbeat()
                 continue

@@ -7,7 +7,19 @@ from pathlib import Path
 from bench.orchestrator import duration_warnings
 from bench.scenario import load_scenario
 
-QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+QUICKSTART = SCENARIOS / "quickstart.toml"
+FAULTS = """
+[[faults]]
+t_s = 20.0
+kind = "stuck_open"
+thruster = 2
+
+[[faults]]
+t_s = 40.0
+kind = "stuck_closed"
+thruster = 5
+"""
 
 
 def test_run_too_short_for_its_steady_state_window_is_warned() -> None:
@@ -19,3 +31,19 @@ def test_run_too_short_for_its_steady_state_window_is_warned() -> None:
     assert duration_warnings(sc, needed_s) == []
     (w,) = duration_warnings(sc, needed_s / 2)
     assert f"at least {needed_s:g} s" in w and "steady-state window" in w
+
+
+def test_run_that_ends_before_scheduled_faults_and_events_is_warned(tmp_path: Path) -> None:
+    """--duration before a fault or capture time: a warning names each one that never acts."""
+    path = tmp_path / "faulty.toml"
+    path.write_text(QUICKSTART.read_text(encoding="utf-8") + FAULTS, encoding="utf-8")
+    sc = load_scenario(path)
+    assert not [w for w in duration_warnings(sc, sc.duration_s) if "never act" in w]
+    (w,) = [w for w in duration_warnings(sc, 30.0) if "never act" in w]
+    assert "1 of the scenario's [[faults]]" in w and "stuck_closed at 40 s" in w
+    (w,) = [w for w in duration_warnings(sc, 20.0) if "never act" in w]
+    assert "2 of the scenario's [[faults]]" in w and "stuck_open at 20 s" in w
+    capture = load_scenario(SCENARIOS / "capture_inertia_identification.toml")
+    (event,) = capture.events
+    (w,) = [w for w in duration_warnings(capture, event.t_s) if "never act" in w]
+    assert "[[events]]" in w and f"capture at {event.t_s:g} s" in w

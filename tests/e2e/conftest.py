@@ -38,6 +38,15 @@ class Run:
         return json.loads((self.out / "summary.json").read_text(encoding="utf-8"))
 
 
+def trace_lines(trace: Path) -> list[str]:
+    """An ASC trace's content without its wall-clock header (date line)."""
+    return [
+        ln
+        for ln in trace.read_text().splitlines()
+        if not ln.startswith(("date", "Begin Triggerblock"))
+    ]
+
+
 def run_cli(args: list[str], out: Path, runtime_dir: Path, timeout_s: float = RUN_TIMEOUT_S) -> Run:
     """Run ``thruster-hil ARGS --out OUT`` with a private hilbus runtime directory."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.e2e.conftest import QUICKSTART, REPO, run_cli, unique_bus
+from tests.e2e.conftest import QUICKSTART, REPO, run_cli, trace_lines, unique_bus
 
 pytestmark = pytest.mark.slow
 
@@ -19,15 +19,6 @@ CONTROL_PERIOD_S = 0.02
 WATCHDOG_PERIODS = 3
 EXIT_BAD_INPUT = 2
 REALTIME_S = "3"
-
-
-def _frames(trace: Path) -> list[str]:
-    """Trace content without the wall-clock header (date line)."""
-    return [
-        ln
-        for ln in trace.read_text().splitlines()
-        if not ln.startswith(("date", "Begin Triggerblock"))
-    ]
 
 
 def test_same_seed_gives_identical_trace_other_seed_differs(
@@ -42,7 +33,7 @@ def test_same_seed_gives_identical_trace_other_seed_differs(
         )
         for i, seed in enumerate(("11", "11", "12"))
     ]
-    traces = [_frames(r.out / "trace.asc") for r in runs]
+    traces = [trace_lines(r.out / "trace.asc") for r in runs]
     assert len(traces[0]) > 1000
     assert traces[0] == traces[1]
     assert traces[0] != traces[2]
@@ -96,6 +87,7 @@ def test_bad_flight_software_value_names_key_and_value(tmp_path: Path, runtime_d
     assert r.returncode == EXIT_BAD_INPUT, r.stderr
     assert "refused its configuration" in r.stderr
     assert "flight_sw.modulator.kind" in r.stderr and "'pwfp'" in r.stderr
+    assert "flight_sw.modulator.kind" in r.summary["fsw"]["refused"]  # from its stats file
     assert (tmp_path / "run" / "fsw.log").exists()  # the run folder still says what happened
 
 

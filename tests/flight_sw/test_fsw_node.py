@@ -24,7 +24,7 @@ from dbc.codec import Encoder, FrameChecker, cycle_time_ns
 from dbc.quaternion import pack_quaternion
 from flight_sw.config import build_computer
 from flight_sw.modes import FdirFlag, Mode, SensorFlag
-from flight_sw.node import FULL_ON_OVERLAP_S, FlightNode
+from flight_sw.node import FULL_ON_OVERLAP_S, HEARTBEAT_RETRY_S, FlightNode
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 RECV_TIMEOUT_S = 5.0
@@ -34,6 +34,8 @@ SAFE_AFTER_CYCLES = 2  # 3 IMU periods (30 ms) of silence are over within 2 cont
 FULL_ON_S = PERIOD_S + FULL_ON_OVERLAP_S
 GYRO_LSB_RAD_S = 2e-5  # the scripted gyro steps by one LSB per sample (a live sensor)
 HEARTBEAT_WAIT_S = 3.0  # the node repeats FSW_STATUS after 1 s without frames
+# once cycling in lockstep it waits longer (the default is 5 s; shortened for the test)
+TEST_SILENCE_HEARTBEAT_S = HEARTBEAT_RETRY_S + 0.5
 
 
 class Bench:
@@ -225,11 +227,13 @@ def test_bench_time_going_backwards_is_a_restart(setup: tuple[FlightNode, Bench]
 
 
 def test_heartbeat_resumes_when_the_bench_goes_quiet(setup: tuple[FlightNode, Bench]) -> None:
-    """After a second without frames the node sends FSW_STATUS alone, with its current mode."""
-    _, bench = setup
+    """Once cycling, after its lockstep silence (not 1 s) the node sends FSW_STATUS alone."""
+    node, bench = setup
+    node.lockstep_silence_heartbeat_s = TEST_SILENCE_HEARTBEAT_S
     for k in range(3):
         bench.sensors()
         bench.sync(k)
+    assert bench.bus.recv(HEARTBEAT_RETRY_S) is None  # a bench paused this long is not gone
     msg = bench.bus.recv(HEARTBEAT_WAIT_S)
     assert msg is not None
     d = bench.chk.check(msg)

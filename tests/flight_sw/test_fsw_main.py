@@ -1,0 +1,32 @@
+"""The flight-software entry point: a refused configuration exits 2 and says why."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from bench.scenario import load_scenario
+from flight_sw.__main__ import EXIT_BAD_INPUT, main
+
+QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
+
+
+def test_refused_configuration_exits_2_with_the_reason_in_the_stats_file(tmp_path: Path) -> None:
+    """A bad modulator kind: exit 2, stderr and the --stats file both name key and value."""
+    cfg = load_scenario(QUICKSTART).fsw_config()
+    cfg["flight_sw"]["modulator"]["kind"] = "pwfp"
+    config = tmp_path / "fsw_config.json"
+    config.write_text(json.dumps(cfg), encoding="utf-8")
+    stats = tmp_path / "fsw_stats.json"
+    assert main(["--config", str(config), "--stats", str(stats)]) == EXIT_BAD_INPUT
+    refused = json.loads(stats.read_text(encoding="utf-8"))["refused"]
+    assert "modulator.kind" in refused and "'pwfp'" in refused
+
+
+def test_good_configuration_checks_ok_and_writes_no_refusal(tmp_path: Path) -> None:
+    """--check on the quickstart's configuration: exit 0, nothing refused."""
+    config = tmp_path / "fsw_config.json"
+    config.write_text(json.dumps(load_scenario(QUICKSTART).fsw_config()), encoding="utf-8")
+    stats = tmp_path / "fsw_stats.json"
+    assert main(["--config", str(config), "--check", "--stats", str(stats)]) == 0
+    assert not stats.exists()
