@@ -614,13 +614,18 @@ class BenchNode:
         return fires
 
     def _chain(self, cycle: int, imu_counter: int, t_cmd_ns: int, t_fire_ns: int | None) -> None:
-        """One row of chains.csv: IMU sample -> last command frame -> first valve opening."""
+        """One row of chains.csv: IMU sample -> last command frame -> first valve opening.
+
+        ``t_fire_ns``: receipt of the first command frame that fires a valve (the opening
+        follows it by the valve's opening delay), None when no valve fires this cycle.
+        """
         t_imu = self.imu_tx_ns.get(imu_counter)
         if t_imu is not None:
             self.latency_ns.append(t_cmd_ns - t_imu)
+        t_fire = NAN if t_fire_ns is None else t_fire_ns / NS_PER_S
         t_open = NAN if t_fire_ns is None else (t_fire_ns + self.open_delay_ns) / NS_PER_S
         self.chains.row([cycle, imu_counter, NAN if t_imu is None else t_imu / NS_PER_S,
-                         t_cmd_ns / NS_PER_S, t_open])
+                         t_cmd_ns / NS_PER_S, t_fire, t_open])
 
     # -- lockstep ----------------------------------------------------------------
     def wait_for_fsw(self) -> None:

@@ -35,7 +35,10 @@ TRACE_EVENTS = frozenset({"fault_injected", "fault_cleared", "valve_watchdog",
                           "valve_watchdog_cleared", "fsw_silent", "fsw_back", "fsw_restart"})
 COUNTER_MASK = 0x0F
 FRAME_COLUMNS = ["t_ready_s", "t_start_s", "t_rx_s", "id", "dlc", "bits", "tx", "counter"]
-CHAIN_COLUMNS = ["cycle", "imu_counter", "t_imu_tx_s", "t_cmd_rx_s", "t_valve_open_s"]
+# per control cycle: IMU sample sent, last command frame received, first command frame that
+# fires a valve received, that valve opening (nan: no valve fired)
+CHAIN_COLUMNS = ["cycle", "imu_counter", "t_imu_tx_s", "t_cmd_rx_s", "t_fire_cmd_rx_s",
+                 "t_valve_open_s"]
 NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at 1e4 s
 
 

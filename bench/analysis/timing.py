@@ -20,7 +20,9 @@ Measurements over the timing files of a run folder (written by :mod:`bench.recor
 Inputs
 ------
 ``frames.csv`` (``t_ready_s, t_start_s, t_rx_s, id, dlc, bits, tx, counter``),
-``chains.csv`` (``cycle, imu_counter, t_imu_tx_s, t_cmd_rx_s, t_valve_open_s``) and
+``chains.csv`` (``cycle, imu_counter, t_imu_tx_s, t_cmd_rx_s, t_fire_cmd_rx_s,
+t_valve_open_s``; run folders written before ``t_fire_cmd_rx_s`` existed read it as
+``t_cmd_rx_s``) and
 ``summary.json`` (``mode``, ``bitrate_bps``). Time base: lockstep = simulated seconds
 (modelled times), realtime = seconds since the bench started (measured), live = seconds
 since the first frame heard. Names, senders and cycle times come from the DBC.
@@ -104,6 +106,7 @@ UNKNOWN_NODE = "?"
 NO_COUNTER = -1  # recorder's counter for frames too short to carry one
 OPTIONS_SOURCE = "TimingOptions"
 RUN_SOURCE = "RunTiming"
+FIRE_COLUMN = "t_fire_cmd_rx_s"  # chains.csv: the first firing command frame received
 
 
 def _is_real(value: object) -> bool:
@@ -241,12 +244,26 @@ class ChainTable:
     imu_counter: np.ndarray
     t_imu_tx_s: np.ndarray
     t_cmd_rx_s: np.ndarray
+    t_fire_cmd_rx_s: np.ndarray
     t_valve_open_s: np.ndarray
 
     @classmethod
     def from_columns(cls, cols: Mapping[str, Any]) -> ChainTable:
-        """From a mapping of the ``chains.csv`` column names to sequences."""
+        """From a mapping of the ``chains.csv`` column names to sequences.
+
+        Without ``t_fire_cmd_rx_s`` (older run folders) the last command frame stands in.
+        """
+        if FIRE_COLUMN not in cols:
+            cols = {**cols, FIRE_COLUMN: cols["t_cmd_rx_s"]}
         return cls(*(np.asarray(cols[k], dtype=float) for k in CHAIN_COLUMNS))
+
+    @classmethod
+    def read(cls, path: Path) -> ChainTable:
+        """``chains.csv`` of a run folder (also one written before ``t_fire_cmd_rx_s``)."""
+        with open(path, newline="", encoding="utf-8") as f:
+            head = next(csv.reader(f), [])
+        cols = [c for c in CHAIN_COLUMNS if c != FIRE_COLUMN or c in head]
+        return cls.from_columns(read_csv_columns(path, cols))
 
     def __len__(self) -> int:
         return len(self.cycle)
@@ -488,7 +505,8 @@ class ChainTiming:
     """IMU sample -> command -> valve opening over the control cycles of a run.
 
     ``imu_to_command``: last command frame received minus the IMU sample's transmission;
-    ``command_to_valve``: first valve opening minus that reception; ``imu_to_valve``: the
+    ``command_to_valve``: first valve opening minus the reception of the command frame
+    that opened it (the valve's opening delay, longer under a valve fault); ``imu_to_valve``: the
     age of the IMU data when the first valve opens. Cycles where no valve fired have no
     valve samples (``cycles_without_valve``).
     """
@@ -516,7 +534,7 @@ def chain_timing(chains: ChainTable) -> ChainTiming:
     return ChainTiming(
         cycles=len(chains),
         imu_to_command=Percentiles.of_seconds(chains.t_cmd_rx_s - chains.t_imu_tx_s),
-        command_to_valve=Percentiles.of_seconds(chains.t_valve_open_s - chains.t_cmd_rx_s),
+        command_to_valve=Percentiles.of_seconds(chains.t_valve_open_s - chains.t_fire_cmd_rx_s),
         imu_to_valve=Percentiles.of_seconds(chains.t_valve_open_s - chains.t_imu_tx_s),
         cycles_without_valve=int(np.count_nonzero(~fired)),
     )
@@ -661,11 +679,7 @@ class RunTiming:
             log = receive_log(read_csv_columns(d / RX_LOG_FILE, RX_LOG_COLUMNS), float(origin))
             frames = dataclasses.replace(frames, t_rx_s=fill_reception(
                 frames.t_ready_s, frames.t_rx_s, frames.can_id, frames.tx, frames.counter, log))
-        chains = (
-            ChainTable.from_columns(read_csv_columns(d / "chains.csv", CHAIN_COLUMNS))
-            if (d / "chains.csv").exists()
-            else None
-        )
+        chains = ChainTable.read(d / "chains.csv") if (d / "chains.csv").exists() else None
         return cls(
             frames,
             chains,

@@ -345,13 +345,15 @@ def test_rta_bound_and_flag(tmp_path: Path) -> None:
 
 
 def test_chain_percentiles(tmp_path: Path) -> None:
-    """Command 1.2 ms after the IMU sample, valve 4 ms after it on even cycles only."""
+    """Last command 1.2 ms after the IMU sample; on even cycles the firing frame (1.0 ms)
+    opens a valve 3 ms later: command->valve is measured from that frame, not the last."""
     chains = [
         [
             k,
             (2 * k) % 15,
             k * CMD_PERIOD_S,
             k * CMD_PERIOD_S + 1.2 * MS,
+            k * CMD_PERIOD_S + 1.0 * MS if k % 2 == 0 else NAN,
             k * CMD_PERIOD_S + 4 * MS if k % 2 == 0 else NAN,
         ]
         for k in range(10)
@@ -359,8 +361,17 @@ def test_chain_percentiles(tmp_path: Path) -> None:
     ch = RunTiming.load(_write_run(tmp_path, [], chains=chains)).chain()
     assert (ch.cycles, ch.cycles_without_valve) == (10, 5)
     assert ch.imu_to_command.p99_us == pytest.approx(1200, abs=TIME_TOL_US * 1e3)
-    assert ch.command_to_valve.max_us == pytest.approx(2800, abs=TIME_TOL_US * 1e3)
+    assert ch.command_to_valve.max_us == pytest.approx(3000, abs=TIME_TOL_US * 1e3)
     assert (ch.imu_to_valve.p50_us, ch.imu_to_valve.n) == pytest.approx((4000, 5), abs=1e-3)
+
+
+def test_chain_of_an_older_run_folder_measures_from_the_last_command(tmp_path: Path) -> None:
+    """chains.csv without t_fire_cmd_rx_s (written before it existed) still loads."""
+    d = _write_run(tmp_path, [])
+    old = [c for c in CHAIN_COLUMNS if c != "t_fire_cmd_rx_s"]
+    (d / "chains.csv").write_text(",".join(old) + f"\n0,0,0,{1.2 * MS},{4 * MS}\n")
+    ch = RunTiming.load(d).chain()
+    assert ch.command_to_valve.max_us == pytest.approx(2800, abs=TIME_TOL_US * 1e3)
 
 
 def test_missing_and_truncated_files(tmp_path: Path) -> None:
@@ -376,7 +387,7 @@ def test_missing_and_truncated_files(tmp_path: Path) -> None:
 def test_json_and_report_outputs(tmp_path: Path) -> None:
     """timing.json is strict JSON (no NaN), the table names every message, PNGs are written."""
     rows = _periodic(IMU_RATE, IMU_PERIOD_S, 11, NAN) + _periodic(SYNC, CMD_PERIOD_S, 6, 120 * US)
-    chains = [[0, 0, 0.0, 1.2 * MS, 4 * MS]]
+    chains = [[0, 0, 0.0, 1.2 * MS, 1.0 * MS, 4 * MS]]
     rt = RunTiming.load(_write_run(tmp_path, rows, mode="realtime", chains=chains))
     path = write_json(rt, tmp_path)
     data = json.loads(path.read_text(encoding="utf-8"))

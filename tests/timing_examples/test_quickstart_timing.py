@@ -18,6 +18,8 @@ DURATION_S = 5.0  # 250 control cycles
 # Requirements under test (illustrative figures for the quickstart vehicle):
 IMU_TO_COMMAND_P99_MAX_US = 2000.0  # a command is computed from IMU data at most 2 ms old
 IMU_TO_VALVE_MAX_US = 5000.0  # ... and opens a valve within 5 ms of the IMU sample
+VALVE_OPEN_DELAY_US = 3000.0  # the quickstart's open_delay_s: command frame -> valve open
+MODELLED_TIME_TOL_US = 0.01  # lockstep times are exact nanoseconds, written to 10 digits
 BUS_LOAD_PEAK_MAX_PCT = 30.0  # at 1 Mbit/s, in any 10 ms window
 SLOW_BITRATE_BPS = 125_000
 SLOW_BUS_LATENCY_FACTOR_MIN = 4.0  # 8x longer frames; queueing behind bench frames adds more
@@ -39,6 +41,14 @@ def test_valve_opens_on_fresh_data(run: HilRun) -> None:
     chain = run.chain()
     assert chain.imu_to_valve.n > 0
     assert chain.imu_to_valve.max_us < IMU_TO_VALVE_MAX_US
+
+
+def test_valve_opens_its_delay_after_its_command(run: HilRun) -> None:
+    """The frame that commands a firing -> that valve open: the valve's opening delay."""
+    c = run.chain().command_to_valve
+    assert c.n > 0
+    assert c.p50_us == pytest.approx(VALVE_OPEN_DELAY_US, abs=MODELLED_TIME_TOL_US)
+    assert c.max_us == pytest.approx(VALVE_OPEN_DELAY_US, abs=MODELLED_TIME_TOL_US)
 
 
 def test_every_periodic_message_on_time(run: HilRun) -> None:
