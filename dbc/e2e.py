@@ -42,8 +42,15 @@ def crc8_sae_j1850(data: bytes | bytearray, init: int = CRC8_INIT) -> int:
 
 
 def frame_crc(data_id: int, payload: bytes | bytearray) -> int:
-    """CRC of a frame: over the data ID (low, high byte) and payload bytes 1..end."""
-    return crc8_sae_j1850(bytes((data_id & 0xFF, (data_id >> 8) & 0xFF)) + bytes(payload[1:]))
+    """CRC of a frame: over the data ID (low, high byte) and payload bytes 1..end.
+
+    The same as ``crc8_sae_j1850(bytes((lo, hi)) + payload[1:])``, without building it.
+    """
+    t = _TABLE
+    crc = t[t[CRC8_INIT ^ (data_id & 0xFF)] ^ ((data_id >> 8) & 0xFF)]
+    for b in payload[1:]:
+        crc = t[crc ^ b]
+    return crc ^ CRC8_XOR_OUT
 
 
 def protect(data_id: int, payload: bytearray, counter: int) -> bytearray:

@@ -55,3 +55,14 @@ def test_counter_delta_wraps_at_15() -> None:
     assert e2e.counter_delta(14, 0) == 1
     assert e2e.counter_delta(3, 3) == 0
     assert e2e.counter_delta(13, 2) == 4
+
+
+def test_frame_crc_is_the_crc_over_data_id_then_payload_tail() -> None:
+    """frame_crc(id, p) == CRC-8 over (id low, id high, p[1:]) on random frames."""
+    rng = random.Random(2)
+    for _ in range(RANDOM_FRAMES):
+        payload = rng.randbytes(rng.randrange(1, 65))
+        did = rng.randrange(1 << 16)
+        expected = e2e.crc8_sae_j1850(bytes((did & 0xFF, did >> 8)) + payload[1:])
+        assert e2e.frame_crc(did, payload) == expected
+        assert e2e.frame_crc(did, bytearray(payload)) == expected

@@ -1,0 +1,134 @@
+"""Per-message bit layouts compiled once from the cantools database: the frame hot path.
+
+What it does: for one DBC message, turns physical signal values into the payload bytes
+and back, exactly as cantools' ``Message.encode(values, scaling=True, strict=False)`` and
+``Message.decode(data, decode_choices=False, scaling=True)`` do, without their per-call
+generality (choices, multiplexing, containers, truncation, argument checks). The bit
+positions are cantools' own compiled ``bitstruct`` formats
+(``cantools.database.utils.create_encode_decode_formats``) and the scale, offset and
+range of every signal are read from the cantools ``Signal`` objects, so the DBC stays the
+only place an ID, a position or a scale factor is written.
+
+In: a ``cantools`` ``Message`` (not multiplexed: every frame of ``thruster_hil.dbc``).
+Out (:meth:`FrameLayout.pack`): an ``bytearray`` of the message's length, CRC and alive
+counter bytes still to be written by :func:`dbc.e2e.protect`. In (:meth:`FrameLayout.unpack`):
+payload bytes -> ``{signal: physical value}``, ints for unscaled integer signals as cantools
+returns them. Range checks on encoding: a value outside the DBC's [minimum, maximum] raises
+:class:`~dbc.errors.IcdError` naming the signal, the value and the range.
+
+Conversions (cantools ``conversion.py``): identity and linear -> ``(v - offset) / scale``
+(rounded half to even if integer; for identity, offset 0 and scale 1 give cantools' own
+``round(v)``), and back ``raw * scale + offset`` (identity: the raw value itself); any
+other conversion calls cantools' own method. The contract
+test ``tests/dbc/test_layout.py`` checks byte-identical encoding and identical decoding
+against cantools on random values and payloads of every message.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from cantools.database.can import Message
+from cantools.database.conversion import IdentityConversion, LinearConversion
+from cantools.database.utils import create_encode_decode_formats
+
+from dbc.errors import IcdError
+
+IDENTITY, LINEAR, OTHER = 0, 1, 2  # how a signal converts between raw and physical
+
+
+def _mode(signal: Any) -> int:
+    conv = signal.conversion
+    if type(conv) is IdentityConversion:
+        return IDENTITY
+    if type(conv) is LinearConversion:
+        return LINEAR
+    return OTHER
+
+
+class FrameLayout:
+    """Encode and decode one message's signals (see the module docstring)."""
+
+    def __init__(self, message: Message) -> None:
+        if message.is_multiplexed() or message.is_container:
+            raise IcdError(f"message {message.name}: multiplexed or container frames unsupported")
+        self.message = message
+        self.name = message.name
+        self.length = message.length
+        formats = create_encode_decode_formats(message.signals, message.length)
+        self._big = formats.big_endian
+        self._little = formats.little_endian
+        inf = float("inf")
+        # encoding: (name, lo, hi, scale, offset, to_int) for identity and linear signals
+        # (identity = scale 1, offset 0, exactly), (name, lo, hi, conversion) for the others
+        self._enc = tuple(
+            (s.name, -inf if s.minimum is None else float(s.minimum),
+             inf if s.maximum is None else float(s.maximum),
+             s.conversion.scale, s.conversion.offset, not s.conversion.is_float)
+            for s in message.signals if _mode(s) != OTHER
+        )
+        self._enc_other = tuple(
+            (s.name, -inf if s.minimum is None else float(s.minimum),
+             inf if s.maximum is None else float(s.maximum), s.conversion)
+            for s in message.signals if _mode(s) == OTHER
+        )
+        # decoding: (name, mode, scale, offset, conversion)
+        self._dec = tuple(
+            (s.name, _mode(s), s.conversion.scale, s.conversion.offset, s.conversion)
+            for s in message.signals
+        )
+
+    def pack(self, values: Mapping[str, Any], source: Mapping[str, Any] | None = None) -> bytearray:
+        """Payload carrying ``values`` (physical units; every signal of the message).
+
+        ``source``: what to quote in an error (default ``values``).
+        """
+        raw: dict[str, int | float] = {}
+        try:
+            for name, lo, hi, scale, offset, to_int in self._enc:
+                v = values[name]
+                if not lo <= v <= hi:
+                    raise ValueError(name)
+                r = (v - offset) / scale
+                raw[name] = round(r) if to_int else r
+            for name, lo, hi, conv in self._enc_other:
+                v = values[name]
+                if not lo <= v <= hi:
+                    raise ValueError(name)
+                raw[name] = conv.numeric_scaled_to_raw(v)
+            packed = int.from_bytes(self._big.pack(raw), "big") | int.from_bytes(
+                self._little.pack(raw), "little"
+            )
+        except Exception as exc:  # the slow path: say which value and why
+            raise self._error(values, source, exc) from None
+        return bytearray(packed.to_bytes(self.length, "big"))
+
+    def _error(self, values: Mapping[str, Any], source: Mapping[str, Any] | None,
+               exc: Exception) -> IcdError:
+        """The IcdError for a ``pack`` that failed with ``exc``: the first bad signal."""
+        quoted = values if source is None else source
+        for name, lo, hi in [e[:3] for e in self._enc] + [e[:3] for e in self._enc_other]:
+            v = values.get(str(name))
+            try:
+                bad = not lo <= v <= hi  # type: ignore[operator]
+            except TypeError:  # missing or not a number
+                bad = True
+            if bad:
+                return IcdError(f"cannot encode {self.name}: {name} = {v!r} outside "
+                                f"[{lo}, {hi}] (or missing) in {quoted}")
+        return IcdError(f"cannot encode {self.name} from {quoted}: {exc}")
+
+    def unpack(self, data: bytes | bytearray) -> dict[str, Any]:
+        """Physical signal values of a payload of exactly ``length`` bytes."""
+        unpacked = {**self._big.unpack(data), **self._little.unpack(data[::-1])}
+        out: dict[str, Any] = {}
+        for name, mode, scale, offset, conv in self._dec:
+            raw = unpacked[name]
+            if mode == IDENTITY:
+                out[name] = raw
+            elif mode == LINEAR:
+                out[name] = raw * scale + offset
+            else:
+                out[name] = conv.raw_to_scaled(raw, False)
+        return out
