@@ -22,6 +22,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -125,10 +126,16 @@ def run_scenario(
     run folder is completed (from the files written so far) even if the bench is killed.
     """
     out = opts.out
-    out.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(sc.path, out / "scenario.toml")
-    config = out / "fsw_config.json"
-    config.write_text(json.dumps(sc.fsw_config(), indent=2) + "\n", encoding="utf-8")
+    check_bus(opts.bus)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(sc.path, out / "scenario.toml")
+        config = out / "fsw_config.json"
+        config.write_text(json.dumps(sc.fsw_config(), indent=2) + "\n", encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError("command line", "--out", str(out),
+                          f"a folder this user can create and write ({exc.strerror or exc})"
+                          ) from exc
     if not hasattr(os, "fork"):  # pragma: no cover - no supervisor where fork is missing
         return _run_bench(sc, opts, progress, ready, config)
     pid = os.fork()
@@ -143,8 +150,10 @@ def run_scenario(
             code = EXIT_CHILD_BAD_INPUT
         except RunError:
             code = EXIT_CHILD_RUN_ERROR
-        except BaseException:
+        except BaseException as exc:
             code = EXIT_CHILD_CRASH
+            if not (out / "summary.json").exists() and not isinstance(exc, KeyboardInterrupt):
+                traceback.print_exc()  # nothing else will say what happened
         finally:
             sys.stdout.flush()
             sys.stderr.flush()
@@ -157,6 +166,11 @@ def run_scenario(
     (out / "bench.pid").unlink(missing_ok=True)  # a pid file names a running process only
     if os.WIFSIGNALED(status):
         summary = partial_summary(sc, opts, f"bench process killed by signal {os.WTERMSIG(status)}")
+        raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
+    if not (out / "summary.json").exists():  # it failed before its run folder was set up
+        summary = partial_summary(
+            sc, opts, f"bench process exited with code {os.WEXITSTATUS(status)} before "
+            "writing summary.json (see its traceback above)")
         raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     if os.WEXITSTATUS(status) == EXIT_CHILD_BAD_INPUT:
@@ -258,6 +272,15 @@ def _run_bench(
         tail = "".join(f"\n  fsw.log: {x}" for x in summary["fsw"].get("log_tail", []))
         raise RunError(f"run failed ({summary['error']}); run folder: {out}{tail}") from error
     return summary
+
+
+def check_bus(spec: str) -> None:
+    """Open and close ``spec`` once: a bus that cannot be opened fails here, with its reason.
+
+    Raises :class:`~dbc.errors.BusError` (exit 2 from the CLI) instead of letting the forked
+    bench fail where only its exit code is seen.
+    """
+    open_bus(spec).shutdown()
 
 
 def duration_warnings(sc: Scenario, duration_s: float) -> list[str]:

@@ -16,6 +16,7 @@ lose frames. ``SO_RCVBUFFORCE`` is used where the process may (CAP_NET_ADMIN), e
 
 from __future__ import annotations
 
+import errno
 import socket
 from dataclasses import dataclass
 from pathlib import Path
@@ -95,7 +96,10 @@ def open_bus(spec: str | BusSpec, **kwargs: object) -> can.BusABC:
     try:
         bus = can.Bus(interface=bs.interface, channel=bs.channel, **options)  # type: ignore[arg-type]
     except (can.CanError, OSError, ValueError, ImportError, NotImplementedError) as exc:
-        raise BusError(f"cannot open bus {bs}: {exc}") from exc
+        hint = ""
+        if bs.interface == "socketcan" and getattr(exc, "errno", None) == errno.EAFNOSUPPORT:
+            hint = " (this kernel has no SocketCAN: use the portable bus, e.g. --bus hilbus:NAME)"
+        raise BusError(f"cannot open bus {bs}: {exc}{hint}") from exc
     sock = getattr(bus, "socket", None)
     if bs.interface == "socketcan" and isinstance(sock, socket.socket):
         enlarge_receive_buffer(sock)
