@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from dbc.bus import BusSpec, default_bus_spec
-from dbc.errors import BusError, ConfigError, RunError
+from dbc.errors import BusError, ConfigError, IcdError, RunError
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
@@ -212,7 +212,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "(a FAULT_CMD frame, acknowledged by the bench)")
     inj.add_argument("kind", help="fault kind, e.g. stuck_open, degraded, drop, bus_off, outage")
     inj.add_argument("--bus", help="bus spec of the running bench")
-    inj.add_argument("--target", type=lambda x: int(x, 0), required=True,
+    inj.add_argument("--target", type=_integer, required=True,
                      help="thruster index, sensor index (0 gyro, 1 accelerometer, 2 star "
                      "tracker), message CAN ID (e.g. 0x40) or node index (0 BENCH, 1 FSW)")
     inj.add_argument("--duration", type=float, default=0.0,
@@ -231,6 +231,14 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("--jobs", type=int, default=1)
     cp.add_argument("--kinds", nargs="+", default=["stuck_closed", "stuck_open"])
     return p
+
+
+def _integer(text: str) -> int:
+    """An integer in any base Python reads (``3``, ``0x40``), for argparse."""
+    try:
+        return int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected an integer, e.g. 3 or 0x40") from None
 
 
 def _cmd_inject(args: argparse.Namespace) -> int:
@@ -333,7 +341,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "campaign":
             return _cmd_campaign(args)
         return _cmd_run(args, alone=args.command == "bench")
-    except (ConfigError, BusError) as exc:
+    except (ConfigError, BusError, IcdError) as exc:
         print(f"thruster-hil: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except RunError as exc:

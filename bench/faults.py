@@ -40,6 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from dbc.errors import ConfigError
 from dbc.schema import Table
 
 THRUSTER_KINDS = ("stuck_closed", "stuck_open", "degraded", "delayed", "intermittent", "leak",
@@ -191,27 +192,33 @@ FAULT_CMD_PARAM = {"degraded": "factor", "misaligned": "angle_deg", "delayed": "
                    "intermittent": "dropout_probability", "leak": "thrust_N", "noise": "factor"}
 FAULT_CMD_AXIS_B = (0.0, 0.0, 1.0)  # misalignment axis of a FAULT_CMD (not encodable)
 FAULT_CMD_NODES = ("BENCH", "FSW")
+FAULT_CMD_SOURCE = "FAULT_CMD"  # where a refused live command's bad value came from
 KHZ = 1000.0
 
 
 def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thrusters: int,
-                       t_s: float) -> FaultSpec | None:
-    """The fault a FAULT_CMD frame describes (see its DBC comments), or None if unsupported.
+                       t_s: float) -> FaultSpec:
+    """The fault a FAULT_CMD frame describes (see its DBC comments).
 
     Target is a thruster index (thruster kinds), a sensor index (0 gyro, 1 accelerometer,
     2 star tracker), the CAN ID of a message (frame kinds), the CAN ID to babble with
     (babbling), or a node index (bus_off). Param is the kind's one parameter: factor,
     angle (deg, about z_B), extra delay (s), dropout probability, leak thrust (N), bias jump
-    on the sensor's x axis, probability (frame kinds), delay (s) or rate (kHz, babbling).
+    on the sensor's x axis, probability (frame kinds, 0 = 1; at most 1), delay (s) or rate
+    (kHz, babbling). Raises :class:`ConfigError` (source ``FAULT_CMD``) naming the signal
+    and value this bench cannot apply.
     """
-    kind = FAULT_CMD_KINDS.get(int(signals["FaultType"]))
+    code = int(signals["FaultType"])
+    kind = FAULT_CMD_KINDS.get(code)
     target, param = int(signals["Target"]), float(signals["Param"])
     dur = float(signals["Duration"])
     if kind is None:
-        return None
+        raise ConfigError(FAULT_CMD_SOURCE, "FaultType", code,
+                          f"one of {sorted(FAULT_CMD_KINDS)} (see the DBC's VAL_ table)")
     if kind in THRUSTER_KINDS:
         if target >= n_thrusters:
-            return None
+            raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
+                              f"a thruster index 0..{n_thrusters - 1} for {kind}")
         params: dict[str, Any] = {}
         if kind in FAULT_CMD_PARAM:
             params[FAULT_CMD_PARAM[kind]] = param
@@ -220,7 +227,8 @@ def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thr
         return FaultSpec(t_s, kind, dur, thruster=target, params=params)
     if kind in SENSOR_KINDS:
         if target >= len(SENSORS):
-            return None
+            raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
+                              f"a sensor index 0..{len(SENSORS) - 1} ({', '.join(SENSORS)})")
         sensor = SENSORS[target]
         params = {}
         if kind == "noise":
@@ -229,17 +237,30 @@ def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thr
             params[BIAS_JUMP_PARAM[sensor]] = (param, 0.0, 0.0)
         return FaultSpec(t_s, kind, dur, sensor=sensor, params=params)
     if kind == "bus_off":
-        return (FaultSpec(t_s, kind, dur, node=FAULT_CMD_NODES[target])
-                if target < len(FAULT_CMD_NODES) else None)
+        if target >= len(FAULT_CMD_NODES):
+            raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
+                              f"a node index 0..{len(FAULT_CMD_NODES) - 1} "
+                              f"({', '.join(FAULT_CMD_NODES)})")
+        return FaultSpec(t_s, kind, dur, node=FAULT_CMD_NODES[target])
     if kind == "babbling":
-        return (FaultSpec(t_s, kind, dur, node="BABBLER",
-                          params={"can_id": target, "rate_hz": param * KHZ})
-                if param > 0 and target <= MAX_STD_ID else None)
+        if target > MAX_STD_ID:
+            raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
+                              f"an 11-bit CAN ID 0..0x{MAX_STD_ID:X} to babble with")
+        if not param > 0:
+            raise ConfigError(FAULT_CMD_SOURCE, "Param", param, "a babbling rate > 0 kHz")
+        return FaultSpec(t_s, kind, dur, node="BABBLER",
+                         params={"can_id": target, "rate_hz": param * KHZ})
     message = name_of.get(target)
     if message is None:
-        return None
+        raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
+                          f"the CAN ID of a DBC message for {kind}")
     if kind == "delay":
+        if not param > 0:
+            raise ConfigError(FAULT_CMD_SOURCE, "Param", param, "a delay > 0 s")
         return FaultSpec(t_s, kind, dur, message=message,
-                         params={"probability": 1.0, "delay_s": param}) if param > 0 else None
+                         params={"probability": 1.0, "delay_s": param})
+    if param > 1.0:
+        raise ConfigError(FAULT_CMD_SOURCE, "Param", param,
+                          f"a probability in (0, 1] for {kind} (0 means 1)")
     p = param if param > 0 else 1.0
-    return FaultSpec(t_s, kind, dur, message=message, params={"probability": min(p, 1.0)})
+    return FaultSpec(t_s, kind, dur, message=message, params={"probability": p})

@@ -214,6 +214,7 @@ class BenchNode:
         self.active_faults: list[tuple[FaultSpec, int | None]] = []
         self.delayed: list[tuple[int, can.Message, str]] = []
         self.fault_cmd_counter = FAULT_CMD_NONE
+        self.fault_cmd_rejected = False  # the last FAULT_CMD was refused
         self.fdir: dict[str, Any] = {}
         self.fsw_restarts = 0
         self.fault_counts: dict[str, int] = {
@@ -333,6 +334,7 @@ class BenchNode:
             "ActiveFaults": len(self.active_faults),
             "Health": health,
             "FaultCmdCounter": self.fault_cmd_counter,
+            "FaultCmdRejected": int(self.fault_cmd_rejected),
         }
 
     def _queue_due(self, t_ns: int) -> None:
@@ -580,14 +582,23 @@ class BenchNode:
         self.fdir = report
 
     def _on_fault_cmd(self, s: dict[str, float], counter: int) -> None:
-        """A live FAULT_CMD: inject or clear, acknowledged in BENCH_STATUS.FaultCmdCounter."""
+        """A live FAULT_CMD: inject or clear, acknowledged in BENCH_STATUS.FaultCmdCounter.
+
+        A command this bench cannot apply is acknowledged with FaultCmdRejected = 1 and
+        recorded (events.jsonl, and summary.json's ``faults`` with ``applied: false``).
+        """
         self.fault_cmd_counter = counter
         t = max(self.plant.t_ns, self.last_cmd_ns)  # valve events must stay in time order
-        spec = fault_from_command(s, self.name_of, self.n_thr, t / NS_PER_S)
-        if spec is None:
-            self.trace.event(t, "fault_cmd_rejected", **{k: float(v) for k, v in s.items()
-                                                        if k not in ("CRC", "AliveCounter")})
+        try:
+            spec = fault_from_command(s, self.name_of, self.n_thr, t / NS_PER_S)
+        except ValueError as exc:  # ConfigError: a value this bench cannot apply
+            self.fault_cmd_rejected = True
+            fields = {k: float(v) for k, v in s.items() if k not in ("CRC", "AliveCounter")}
+            self.faults_log.append({**fields, "t_s": t / NS_PER_S, "source": "FAULT_CMD",
+                                    "applied": False, "why": str(exc)})
+            self.trace.event(t, "fault_cmd_rejected", **fields, why=str(exc))
             return
+        self.fault_cmd_rejected = False
         if int(s["Action"]) == 0:
             for item in [x for x in self.active_faults if _same_target(x[0], spec)]:
                 self.active_faults.remove(item)

@@ -10,27 +10,34 @@ import pytest
 from bench.inject import FaultCommand, cansend_string, inject
 from dbc import load_database
 from dbc.codec import FrameChecker
+from dbc.errors import RefusedConfigError
 from tests.e2e.conftest import QUICKSTART, running, unique_bus
 
 pytestmark = pytest.mark.slow
 
 RUN_S = "8"
 STUCK = 5
+MISSING_THRUSTER = 12  # the quickstart vehicle has 8
 DEADLINE_S = 60.0
 
 
 def test_inject_reaches_running_bench(
     tmp_path: Path, runtime_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """inject(stuck_open) during a realtime run: acknowledged, applied, in events and summary."""
+    """inject(stuck_open) during a realtime run: acknowledged, applied, in events and summary;
+    one for a thruster the vehicle lacks: refused (exit 2 from the CLI) and recorded so."""
     bus, out = unique_bus(), tmp_path / "run"
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime_dir))
     args = ["run", str(QUICKSTART), "--bus", bus, "--mode", "realtime", "--duration", RUN_S]
     with running(args, out, runtime_dir):
         counter = inject(bus, FaultCommand("stuck_open", STUCK))
+        with pytest.raises(RefusedConfigError, match="not applicable to this bench"):
+            inject(bus, FaultCommand("stuck_open", MISSING_THRUSTER))
     s = json.loads((out / "summary.json").read_text())
     live = [f for f in s["faults"] if f.get("source") == "FAULT_CMD"]
     assert live and live[0]["kind"] == "stuck_open" and live[0]["thruster"] == STUCK
+    refused = [f for f in live if f.get("applied") is False]
+    assert len(refused) == 1 and f"Target = {MISSING_THRUSTER}" in refused[0]["why"]
     assert 0 <= counter < 15
     assert "thruster-hil fault_injected" in (out / "trace.asc").read_text()
 
