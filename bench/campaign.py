@@ -7,7 +7,9 @@ appended, started as its own ``thruster-hil run`` process on a private portable-
 gives detection and isolation. Out, in DIR: ``campaign.csv`` (one row per run: thruster,
 kind, detected, detection time after the fault, isolated thruster, isolation correct,
 expectations met, final attitude and position error, propellant), ``campaign.json`` and
-``campaign.png`` (detection time per thruster and kind), plus every run folder.
+``campaign.png`` (detection time per thruster and kind), plus every run folder. Exit 0 if
+every run detected and isolated its failure and met the scenario's expectations, 1 if not,
+2 on bad input, 3 if a run could not complete.
 """
 
 from __future__ import annotations
@@ -30,8 +32,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 from bench.scenario import load_scenario
+from dbc.errors import ConfigError, RunError
 
 KINDS = ("stuck_closed", "stuck_open")
+DEFAULT_FAULT_TIME_S = 10.0
+EXIT_BAD_INPUT, EXIT_RUN_ERROR = 2, 3  # as thruster-hil run's
 COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruster",
            "isolation_correct", "expectations_met", "final_attitude_error_deg",
            "final_position_error_m", "propellant_kg", "run_dir"]
@@ -44,12 +49,16 @@ def _run_one(scenario: Path, fault: str, out: Path, xdg: Path) -> dict[str, Any]
     sc_file = out / "campaign_scenario.toml"
     sc_file.write_text(text, encoding="utf-8")
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
-    subprocess.run(
+    p = subprocess.run(
         [sys.executable, "-m", "bench.cli", "run", str(sc_file), "--bus",
          f"hilbus:c{uuid.uuid4().hex[:10]}", "--out", str(out / "run")],
-        env=env, capture_output=True, check=False,
+        env=env, capture_output=True, text=True, check=False,
     )
-    return json.loads((out / "run" / "summary.json").read_text(encoding="utf-8"))
+    summary = out / "run" / "summary.json"
+    if p.returncode == EXIT_BAD_INPUT or not summary.exists():
+        last = (p.stderr.strip().splitlines() or ["(no output)"])[-1]
+        raise RunError(f"campaign run {out.name} failed (exit {p.returncode}): {last}")
+    return json.loads(summary.read_text(encoding="utf-8"))
 
 
 def _row(k: int, kind: str, fault_t_s: float, s: dict[str, Any], run_dir: Path) -> dict[str, Any]:
@@ -72,7 +81,13 @@ def _row(k: int, kind: str, fault_t_s: float, s: dict[str, Any], run_dir: Path) 
 def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
                  kinds: tuple[str, ...] = KINDS) -> list[dict[str, Any]]:
     """Run every single-thruster failure of ``kinds``; write the CSV, JSON and PNG."""
-    n = len(load_scenario(scenario).thrusters)
+    sc = load_scenario(scenario)
+    if not 0.0 <= fault_t_s < sc.duration_s:  # also NaN
+        raise ConfigError("command line", "--fault-time", fault_t_s,
+                          f"a time in [0, {sc.duration_s:g}) s (the scenario's duration)")
+    if jobs < 1:
+        raise ConfigError("command line", "--jobs", jobs, "at least 1")
+    n = len(sc.thrusters)
     out.mkdir(parents=True, exist_ok=True)
     cases = [(k, kind) for kind in kinds for k in range(n)]
     with tempfile.TemporaryDirectory(prefix="thil-campaign-") as tmp:
@@ -86,7 +101,13 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
             return _row(k, kind, fault_t_s, _run_one(scenario, fault, d, xdg), d / "run")
 
         with ThreadPoolExecutor(max_workers=jobs) as pool:
-            rows = list(pool.map(job, cases))
+            futures = [pool.submit(job, case) for case in cases]
+            try:
+                rows = [fut.result() for fut in futures]
+            except BaseException:  # one run failed: do not start the others
+                for fut in futures:
+                    fut.cancel()
+                raise
     with open(out / "campaign.csv", "w", newline="", encoding="utf-8") as f:
         w = csv.DictWriter(f, fieldnames=COLUMNS)
         w.writeheader()
@@ -99,7 +120,8 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
 def _plot(rows: list[dict[str, Any]], path: Path) -> None:
     fig, ax = plt.subplots(figsize=(9, 4))
     width = 0.4
-    for i, kind in enumerate(KINDS):
+    kinds = [k for k in KINDS if any(r["kind"] == k for r in rows)]
+    for i, kind in enumerate(kinds):
         sel = [r for r in rows if r["kind"] == kind]
         xs = [r["thruster"] + (i - 0.5) * width for r in sel]
         ys = [r["detection_time_s"] if r["detection_time_s"] is not None else 0.0 for r in sel]
@@ -118,17 +140,32 @@ def _plot(rows: list[dict[str, Any]], path: Path) -> None:
     plt.close(fig)
 
 
+def add_arguments(p: argparse.ArgumentParser, default_jobs: int) -> None:
+    """The campaign's options (shared with ``thruster-hil campaign``)."""
+    p.add_argument("scenario", help="scenario TOML file (its thrusters, duration, seed)")
+    p.add_argument("--out", required=True, help="folder for campaign.csv/.json/.png and runs")
+    p.add_argument("--fault-time", type=float, default=DEFAULT_FAULT_TIME_S,
+                   help=f"when each fault starts [s] (default {DEFAULT_FAULT_TIME_S:g})")
+    p.add_argument("--jobs", type=int, default=default_jobs,
+                   help=f"runs at a time (default {default_jobs})")
+    p.add_argument("--kinds", nargs="+", choices=KINDS, default=list(KINDS),
+                   help="failure kinds (default both)")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Command line; exit 0 if every run was detected, isolated and met its expectations."""
     p = argparse.ArgumentParser(prog="thruster-hil campaign", description=__doc__.split("\n")[0])
-    p.add_argument("scenario")
-    p.add_argument("--out", required=True)
-    p.add_argument("--fault-time", type=float, default=10.0, help="fault time [s]")
-    p.add_argument("--jobs", type=int, default=max(1, (os.cpu_count() or 2) // 2))
-    p.add_argument("--kinds", nargs="+", choices=KINDS, default=list(KINDS))
+    add_arguments(p, default_jobs=max(1, (os.cpu_count() or 2) // 2))
     args = p.parse_args(argv)
-    rows = run_campaign(Path(args.scenario), Path(args.out), args.fault_time, args.jobs,
-                        tuple(args.kinds))
+    try:
+        rows = run_campaign(Path(args.scenario), Path(args.out), args.fault_time, args.jobs,
+                            tuple(args.kinds))
+    except ConfigError as exc:
+        print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RunError as exc:
+        print(f"thruster-hil campaign: run error: {exc}", file=sys.stderr)
+        return EXIT_RUN_ERROR
     for r in rows:
         print(f"T{r['thruster']:02d} {r['kind']:12s} detected={r['detected']!s:5} "
               f"t={r['detection_time_s']} isolated={r['isolated_thruster']} "

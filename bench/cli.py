@@ -225,11 +225,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="only print the frame for cansend, with this alive counter")
     cp = sub.add_parser("campaign", help="every single-thruster stuck_closed / stuck_open "
                         "failure of a scenario, one lockstep run each; CSV + PNG")
-    cp.add_argument("scenario")
-    cp.add_argument("--out", required=True)
-    cp.add_argument("--fault-time", type=float, default=10.0)
-    cp.add_argument("--jobs", type=int, default=1)
-    cp.add_argument("--kinds", nargs="+", default=["stuck_closed", "stuck_open"])
+    from bench.campaign import add_arguments
+
+    add_arguments(cp, default_jobs=1)
     return p
 
 
