@@ -37,7 +37,7 @@ from bench.plots import plot_run
 from bench.recorder import write_summary
 from bench.scenario import Scenario
 from dbc import load_database
-from dbc.bus import open_bus
+from dbc.bus import mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 
@@ -192,7 +192,7 @@ def _run_bench(
     out = opts.out
     stats = out / "fsw_stats.json"
     db = load_database()
-    bus = open_bus(opts.bus)
+    bus = open_bus(opts.bus, **mode_options(opts.bus, opts.mode))
     proc: subprocess.Popen[bytes] | None = None
     node = BenchNode(sc, db, bus, out, opts.mode, opts.seed, opts.bus, progress)
     if ready is not None:

@@ -29,6 +29,13 @@ from dbc.errors import BusError
 DEFAULT_SOCKETCAN_CHANNEL = "vcan0"
 PORTABLE_INTERFACE = "hilbus"
 PORTABLE_DEFAULT_CHANNEL = "default"
+# Realtime on the portable bus: a member whose queue stays full this long (a paused bus
+# monitor) loses frames instead of holding the sender; half a 20 ms control period, below
+# the flight software's IMU loss (3 x 10 ms) and the valve watchdog (3 x 20 ms). A real
+# CAN bus never waits for a receiver. Lockstep keeps hilbus's own 1 s (lossless for slow
+# members; the wait is wall-clock time only).
+REALTIME_MEMBER_STALL_S = 0.010
+MEMBER_STALL_OPTION = "member_stall_s"
 SYS_NET = Path("/sys/class/net")
 SOCKETCAN_RCVBUF_BYTES = 8 * 1024 * 1024  # ~10 000 queued frames (kernel skb accounting)
 SO_RCVBUFFORCE = getattr(socket, "SO_RCVBUFFORCE", 33)  # Linux value; missing on some builds
@@ -70,6 +77,18 @@ class BusSpec:
     def is_portable(self) -> bool:
         """True for the project's own cross-process bus."""
         return self.interface == PORTABLE_INTERFACE
+
+
+def mode_options(spec: str, mode: str) -> dict[str, object]:
+    """Extra ``open_bus`` options a run mode needs on ``spec`` (an option in the spec wins).
+
+    Realtime on the portable bus: ``member_stall_s = REALTIME_MEMBER_STALL_S``.
+    """
+    bs = BusSpec.parse(spec)
+    if mode != "realtime" or not bs.is_portable or any(k == MEMBER_STALL_OPTION
+                                                       for k, _ in bs.options):
+        return {}
+    return {MEMBER_STALL_OPTION: REALTIME_MEMBER_STALL_S}
 
 
 def _coerce(value: str) -> object:

@@ -17,7 +17,7 @@ import sys
 from pathlib import Path
 
 from dbc import load_database
-from dbc.bus import default_bus_spec, open_bus
+from dbc.bus import default_bus_spec, mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.errors import BusError, ConfigError
 from flight_sw.config import build_computer, load_config
@@ -61,7 +61,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.check:
             print(f"{args.config}: configuration ok")
             return 0
-        bus = open_bus(args.bus or default_bus_spec())
+        spec = args.bus or default_bus_spec()
+        bus = open_bus(spec, **mode_options(spec, args.mode))
     except (ConfigError, BusError) as exc:
         print(f"flight_sw: error: {exc}", file=sys.stderr)
         _write_refusal(args.stats, str(exc))

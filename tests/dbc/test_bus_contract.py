@@ -24,10 +24,12 @@ import can
 import pytest
 
 from dbc.bus import (
+    REALTIME_MEMBER_STALL_S,
     SOCKETCAN_RCVBUF_BYTES,
     BusSpec,
     default_bus_spec,
     enlarge_receive_buffer,
+    mode_options,
     open_bus,
 )
 from dbc.errors import BusError
@@ -261,6 +263,35 @@ def test_open_bus_passes_options(monkeypatch: pytest.MonkeyPatch) -> None:
             bus.send(can.Message(arbitration_id=0x33))
             m = bus.recv(timeout=DEADLINE_S)
             assert m is not None and m.arbitration_id == 0x33 and not m.is_rx
+    finally:
+        shutil.rmtree(runtime, ignore_errors=True)
+
+
+def test_realtime_on_the_portable_bus_does_not_wait_for_a_stopped_member() -> None:
+    """Realtime hilbus: member_stall_s is the short realtime one (a spec option wins);
+    lockstep and other interfaces get no extra option."""
+    assert mode_options("hilbus:x", "realtime") == {"member_stall_s": REALTIME_MEMBER_STALL_S}
+    assert mode_options("hilbus:x?member_stall_s=2", "realtime") == {}
+    assert mode_options("hilbus:x", "lockstep") == {}
+    assert mode_options("socketcan:vcan0", "realtime") == {}
+
+
+def test_a_realtime_send_to_a_stopped_member_is_held_only_the_realtime_stall(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A member that never reads: once its queue is full, a realtime sender waits at most
+    about REALTIME_MEMBER_STALL_S once (not hilbus's 1 s), then drops to it and counts."""
+    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
+    spec = f"hilbus:rt-{uuid.uuid4().hex[:8]}"
+    try:
+        with open_bus(spec, **mode_options(spec, "realtime")) as tx, open_bus(spec):
+            t0 = time.monotonic()
+            for _ in range(STREAM_N):
+                tx.send(can.Message(arbitration_id=0x33, data=b"\x00" * 8))
+            held_s = time.monotonic() - t0
+            assert tx.overrun_drops > 0  # type: ignore[attr-defined]
+            assert held_s < 1.0  # hilbus's lockstep stall alone would be 1 s
     finally:
         shutil.rmtree(runtime, ignore_errors=True)
 
