@@ -861,10 +861,9 @@ class BenchNode:
         self._realtime_frame(msg, clock)
 
     def _realtime_frame(self, msg: can.Message, clock: Clock) -> None:
+        """Trace every frame heard (as a CAN logger would, bad ones too), act on good ones."""
         t_ns = clock.now_ns()
         d = self.checker.check(msg)
-        if d is None:
-            return
         tx_wall = getattr(msg, "tx_timestamp", None)  # the portable bus carries the sender's time
         self.trace.frame(
             msg, t_ns, tx=False,
@@ -872,6 +871,8 @@ class BenchNode:
             t_rx_ns=clock.from_wall_ns(msg.timestamp) if msg.timestamp > 0 else t_ns,
             bits=frame_bits(msg.arbitration_id, bytes(msg.data)),
         )
+        if d is None:
+            return
         s: dict[str, float] = d.signals
         if d.name.startswith("THR_CMD_"):
             self._note_lag(t_ns)

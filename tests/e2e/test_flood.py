@@ -5,8 +5,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import can
 import pytest
 
+from dbc import load_database
 from tests.e2e.conftest import QUICKSTART, flood, running, unique_bus
 
 pytestmark = pytest.mark.slow
@@ -19,7 +21,8 @@ LOCKSTEP_FLOOD_FRAMES = 6000
 
 
 def test_flood_is_counted_by_cause_and_nothing_crashes(tmp_path: Path, runtime_dir: Path) -> None:
-    """Every malformed frame is counted under its cause by its receiver; nothing crashes."""
+    """Every malformed frame is counted under its cause by its receiver, and is in the bench's
+    CAN trace (as a logger records what it hears); nothing crashes."""
     bus, out = unique_bus(), tmp_path / "run"
     args = ["run", str(QUICKSTART), "--bus", bus, "--mode", "realtime", "--duration", RUN_S]
     with running(args, out, runtime_dir):
@@ -33,6 +36,11 @@ def test_flood_is_counted_by_cause_and_nothing_crashes(tmp_path: Path, runtime_d
         assert other[side].get("error_frame", 0) == sent["ALL"]["error_frame"], side
         for cause in ("crc", "dlc", "remote_frame"):
             assert frames[own]["rejected"].get(cause, 0) == sent[side][cause], (side, cause)
+    known = {m.frame_id for m in load_database().messages}
+    heard = list(can.LogReader(str(out / "trace.asc")))
+    assert sum(m.is_error_frame for m in heard) == sent["ALL"]["error_frame"]
+    unknown = sum(not m.is_error_frame and m.arbitration_id not in known for m in heard)
+    assert unknown == sent["ALL"]["unknown_id"]
 
 
 def test_flood_does_not_change_lockstep_control(tmp_path: Path, runtime_dir: Path) -> None:
