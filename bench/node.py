@@ -212,6 +212,7 @@ class BenchNode:
         self.faults_log: list[dict[str, Any]] = []
         self.pending_faults = list(sc.faults)
         self.active_faults: list[tuple[FaultSpec, int | None]] = []
+        self._active_records: dict[int, dict[str, Any]] = {}  # id(active fault) -> its record
         self.delayed: list[tuple[int, can.Message, str]] = []
         self.fault_cmd_counter = FAULT_CMD_NONE
         self.fault_cmd_rejected = False  # the last FAULT_CMD was refused
@@ -353,7 +354,7 @@ class BenchNode:
             self._start_fault(f, t_ns, end)
         for item in [x for x in self.active_faults if x[1] is not None and x[1] <= t_ns]:
             self.active_faults.remove(item)
-            self._end_fault(item[0], t_ns)
+            self._end_fault(item[0], t_ns, "duration")
             self.trace.event(t_ns, "fault_cleared", **item[0].record())
 
     def _start_fault(self, f: FaultSpec, t_ns: int, end_ns: int | None,
@@ -375,6 +376,7 @@ class BenchNode:
             rec["until_s"] = until / NS_PER_S
             end_ns = until
         self.active_faults.append((f, end_ns))
+        self._active_records[id(f)] = rec
         self.faults_log.append(rec)
         self.trace.event(t_ns, "fault_injected", **rec)
 
@@ -389,8 +391,15 @@ class BenchNode:
         return {"gyro": self.plant.gyro, "accelerometer": self.plant.accel,
                 "star_tracker": self.plant.star}[name]
 
-    def _end_fault(self, f: FaultSpec, t_ns: int) -> None:
-        """Undo the physical effect of ``f`` (bus faults just stop matching frames)."""
+    def _end_fault(self, f: FaultSpec, t_ns: int, by: str) -> None:
+        """Undo the physical effect of ``f`` (bus faults just stop matching frames).
+
+        Its record in ``faults`` (summary.json) gets ``cleared_t_s`` and ``cleared_by``
+        (``duration`` or ``FAULT_CMD``).
+        """
+        rec = self._active_records.pop(id(f), None)
+        if rec is not None:
+            rec["cleared_t_s"], rec["cleared_by"] = t_ns / NS_PER_S, by
         if f.thruster is not None:
             self.plant.thrusters.clear_fault(f.thruster, f.kind, t_ns)
         elif f.sensor is not None:
@@ -602,7 +611,7 @@ class BenchNode:
         if int(s["Action"]) == 0:
             for item in [x for x in self.active_faults if _same_target(x[0], spec)]:
                 self.active_faults.remove(item)
-                self._end_fault(item[0], t)
+                self._end_fault(item[0], t, "FAULT_CMD")
                 self.trace.event(t, "fault_cleared", **item[0].record(), source="FAULT_CMD")
             return
         end = t + round(spec.duration_s * NS_PER_S) if spec.duration_s > 0 else None

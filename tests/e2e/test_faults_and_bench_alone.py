@@ -17,15 +17,17 @@ pytestmark = pytest.mark.slow
 
 FAULT_T_S = 1.0
 STUCK = 3
+CLEAR_AFTER_S = 0.5
 SHORT_S = "3"
 START_DEADLINE_S = 60.0
 
 
-def _with_faults(tmp_path: Path, kind: str) -> Path:
+def _with_faults(tmp_path: Path, kind: str, duration_s: float = 0.0) -> Path:
     sc = tmp_path / f"{kind}.toml"
     sc.write_text(
         QUICKSTART.read_text()
         + f'\n[[faults]]\nt_s = {FAULT_T_S}\nkind = "{kind}"\nthruster = {STUCK}\n'
+        + f"duration_s = {duration_s}\n"
     )
     return sc
 
@@ -48,6 +50,7 @@ def test_scheduled_thruster_fault_is_applied_and_recorded(
     )
     faults = r.summary["faults"]
     assert [(f["kind"], f["thruster"], f["t_s"]) for f in faults] == [(kind, STUCK, FAULT_T_S)]
+    assert "cleared_t_s" not in faults[0]  # no duration: active to the end
     events = [json.loads(x) for x in (r.out / "events.jsonl").read_text().splitlines()]
     assert any(e["event"] == "fault_injected" and e["t_s"] == FAULT_T_S for e in events)
     after = [f for t, f in _thrust(r.out, STUCK) if t > FAULT_T_S + 0.05]
@@ -55,6 +58,16 @@ def test_scheduled_thruster_fault_is_applied_and_recorded(
         assert max(after) == 0.0
     else:
         assert min(after) > 0.9 * 15.0
+
+
+def test_timed_fault_clearing_is_in_the_summary(tmp_path: Path, runtime_dir: Path) -> None:
+    """A fault with a duration: its summary record says when and why it was cleared."""
+    r = run_cli(
+        ["run", str(_with_faults(tmp_path, "stuck_closed", CLEAR_AFTER_S)), "--bus",
+         unique_bus(), "--duration", SHORT_S], tmp_path / "run", runtime_dir,
+    )
+    (f,) = r.summary["faults"]
+    assert (f["cleared_t_s"], f["cleared_by"]) == (FAULT_T_S + CLEAR_AFTER_S, "duration")
 
 
 def test_bench_alone_pairs_with_flight_software_started_by_hand(
