@@ -26,6 +26,7 @@ from bench.faults import FaultSpec, parse_faults
 from bench.reference import KIND_STEP, KINDS, ReferenceParams, reference
 from bench.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
 from dbc import load_database
+from dbc.codec import BITRATE_ATTRIBUTE, bitrate_range_bps
 from dbc.errors import ConfigError
 from dbc.schema import Table
 
@@ -39,6 +40,7 @@ SQRT_HOUR_S = 60.0  # sqrt(3600 s)
 UNIT_NORM_TOL = 1e-6
 MODES = ("lockstep", "realtime")
 TRANSLATIONS = ("inertial", "hcw")
+FSW_TABLE = "flight_sw"  # the table passed through to the flight software
 """[dynamics] translation: inertial (default) or HCW relative motion (bench.dynamics.hcw)."""
 VALVE_MODELS = ("on_off", "throttled")
 """[thrusters] valve_model: on_off (bench.valves.valve) or throttled (bench.valves.throttled)."""
@@ -239,7 +241,8 @@ class Scenario:
         if self.r_target_N_m is not None:
             manoeuvre["r_target_N_m"] = list(self.r_target_N_m)
         cfg: dict[str, Any] = {
-            "source": self.path,
+            "source": override_source(self.path, [
+                o for o in self.overrides if o.startswith(FSW_TABLE + ".")]),
             "vehicle": {
                 "mass_kg": self.nominal.mass_kg,
                 "inertia_B_kgm2": [list(r) for r in self.nominal.inertia_B_kgm2],
@@ -504,14 +507,16 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     gyro, accel, st, nav = _sensors(root.table("sensors"))
 
     bt = root.table("bus", {})
+    rate_default, rate_lo, rate_hi = bitrate_range_bps(load_database())
     bus = BusSpecCfg(
-        bitrate_bps=bt.integer("bitrate_bps", 1_000_000, lo=10_000),
+        bitrate_bps=bt.integer("bitrate_bps", rate_default, lo=rate_lo),
         fsw_response_delay_s=bt.number("fsw_response_delay_s", 0.001, lo=0.0, hi=0.1),
         stall_timeout_s=bt.number("stall_timeout_s", 2.0, lo=0.0, lo_open=True),
         startup_timeout_s=bt.number("startup_timeout_s", 60.0, lo=0.0, lo_open=True),
     )
-    if bus.bitrate_bps > 1_000_000:
-        raise bt.error("bitrate_bps", bus.bitrate_bps, "at most 1000000 (classic CAN)")
+    if bus.bitrate_bps > rate_hi:
+        raise bt.error("bitrate_bps", bus.bitrate_bps,
+                       f"at most {rate_hi} (the DBC's {BITRATE_ATTRIBUTE} range)")
     bt.done()
 
     it = root.table("initial", {})
@@ -640,4 +645,28 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(str(p), "<syntax>", str(exc), "valid TOML") from exc
     apply_overrides(data, overrides or [], str(p))
-    return dataclasses.replace(parse_scenario(data, str(p)), overrides=tuple(overrides or ()))
+    try:
+        sc = parse_scenario(data, str(p))
+    except ConfigError as exc:
+        item = _override_of(exc.key, overrides or [])
+        if item is None:
+            raise
+        raise ConfigError(override_source(str(p), [item]), exc.key, exc.value,
+                          exc.expected) from exc
+    return dataclasses.replace(sc, overrides=tuple(overrides or ()))
+
+
+def override_source(path: str, items: list[str]) -> str:
+    """Where a value came from: the file, or the ``--set`` items applied to it."""
+    if not items:
+        return path
+    return "command line " + " ".join(f"--set {i}" for i in items) + f" (on {path})"
+
+
+def _override_of(key: str, overrides: list[str]) -> str | None:
+    """The ``--set`` item that wrote ``key`` (or a table above or below it), if any."""
+    for item in reversed(overrides):  # the last one wins, as applied
+        k = item.partition("=")[0]
+        if key == k or key.startswith(k + ".") or k.startswith(key + "."):
+            return item
+    return None

@@ -28,6 +28,7 @@ from dbc.errors import IcdError
 from dbc.layout import FrameLayout
 
 E2E_DATA_ID_ATTRIBUTE = "E2EDataID"
+BITRATE_ATTRIBUTE = "Baudrate"  # BA_DEF_: default, minimum and maximum bitrate [bit/s]
 RANGE_TOLERANCE = 1e-9  # relative slack on DBC min/max for float round-off
 
 
@@ -59,6 +60,15 @@ def cycle_time_ns(db: Database, name: str) -> int:
     if not ms:
         raise IcdError(f"message {name} has no GenMsgCycleTime")
     return int(ms) * 1_000_000
+
+
+def bitrate_range_bps(db: Database) -> tuple[int, int, int]:
+    """(default, minimum, maximum) bitrate [bit/s] of the DBC's ``Baudrate`` definition."""
+    try:
+        a = db.dbc.attribute_definitions[BITRATE_ATTRIBUTE]  # type: ignore[union-attr]
+        return int(str(a.default_value)), int(str(a.minimum)), int(str(a.maximum))
+    except (AttributeError, KeyError, TypeError, ValueError) as exc:
+        raise IcdError(f"the DBC has no usable {BITRATE_ATTRIBUTE} definition ({exc})") from exc
 
 
 def _range_checks(m: Message) -> list[tuple[str, float, float]]:

@@ -11,6 +11,8 @@ from pathlib import Path
 import pytest
 
 from bench.scenario import load_scenario, parse_scenario, quat_from_euler_zyx
+from dbc import load_database
+from dbc.codec import bitrate_range_bps
 from dbc.errors import ConfigError
 
 if sys.version_info >= (3, 11):
@@ -130,3 +132,28 @@ def test_overrides_set_nested_keys_and_are_validated() -> None:
         load_scenario(QUICKSTART, ["bus.bitrate_bps=fast"])
     with pytest.raises(ConfigError, match="KEY=VALUE"):
         load_scenario(QUICKSTART, ["bitrate"])
+
+
+def test_a_bad_override_is_blamed_on_the_command_line() -> None:
+    """A bad or misspelt --set value names --set and the file it was applied to; a bad value
+    from the file itself still names only the file."""
+    for item, key in (("bus.bitrate_bps=fast", "bus.bitrate_bps"),
+                      ("bus.bitrate_bs=125000", "bus.bitrate_bs")):
+        with pytest.raises(ConfigError) as err:
+            load_scenario(QUICKSTART, [item])
+        assert err.value.source == f"command line --set {item} (on {QUICKSTART})"
+        assert err.value.key == key
+    sc = load_scenario(QUICKSTART, ["flight_sw.modulator.km=10.0", "bus.bitrate_bps=125000"])
+    assert sc.fsw_config()["source"] == (
+        f"command line --set flight_sw.modulator.km=10.0 (on {QUICKSTART})")
+    assert load_scenario(QUICKSTART).fsw_config()["source"] == str(QUICKSTART)
+
+
+def test_bitrate_range_is_the_dbc_baudrate_definition() -> None:
+    """bus.bitrate_bps: the DBC's Baudrate minimum and maximum are accepted, beyond refused."""
+    _default, lo, hi = bitrate_range_bps(load_database())
+    for ok in (lo, hi):
+        assert load_scenario(QUICKSTART, [f"bus.bitrate_bps={ok}"]).bus.bitrate_bps == ok
+    for bad in (lo - 1, hi + 1):
+        with pytest.raises(ConfigError, match=rf"bus\.bitrate_bps = {bad}"):
+            load_scenario(QUICKSTART, [f"bus.bitrate_bps={bad}"])
