@@ -165,6 +165,8 @@ def _cmd_timing(args: argparse.Namespace) -> int:
             )
     else:
         run_dir = Path(args.run_dir)
+        if not (run_dir / "summary.json").exists():  # bad input, as for `report`
+            raise ConfigError(str(run_dir), "summary.json", None, "a run folder (no summary.json)")
         rt = RunTiming.load(run_dir, options)
         written = [write_json(rt, run_dir), *write_histograms(rt, run_dir)]
         if args.json:

@@ -55,3 +55,22 @@ def test_bad_out_exits_2_naming_it(tmp_path: Path, runtime: Path,
         code, err = _run(["--bus", bus, "--out", str(out)], capsys)
         assert code == EXIT_BAD_INPUT, err
         assert f"--out = '{out}'" in err and "Traceback" not in err, err
+
+
+def test_bad_fsw_cmd_placeholder_exits_2_before_any_process(
+    tmp_path: Path, runtime: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--fsw-cmd with an unknown {placeholder}: exit 2 naming it; no run folder."""
+    code, err = _run(["--bus", f"hilbus:cli{uuid.uuid4().hex[:8]}", "--out",
+                      str(tmp_path / "run"), "--fsw-cmd", "fsw --config {foo}"], capsys)
+    assert code == EXIT_BAD_INPUT and "--fsw-cmd" in err and "'foo'" in err, err
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("command", ["timing", "report"])
+def test_not_a_run_folder_exits_2(command: str, tmp_path: Path,
+                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """timing and report on a folder without summary.json: both exit 2 naming it."""
+    code = main([command, str(tmp_path / "nothing")])
+    err = capsys.readouterr().err
+    assert code == EXIT_BAD_INPUT and "summary.json" in err, err
