@@ -176,9 +176,15 @@ def write_histograms(rt: RunTiming, out_dir: Path) -> list[Path]:
             rows, cols, figsize=(SUBPLOT_W_IN * cols, SUBPLOT_H_IN * rows), squeeze=False
         )
         for ax, (name, a) in zip(axes.flat, lat.items(), strict=False):
-            ax.hist(a, bins=HIST_BINS, color="C0")
-            bound = rt.messages[name].bound_us
-            if bound is not None and math.isfinite(bound):
+            b = rt.messages[name].bound_us
+            bound = float(b) if b is not None and math.isfinite(b) else None
+            # bins over the whole axis (0 .. the bound): a narrow spread far below its bound
+            # stays visible as a bar instead of slivers a fraction of a pixel wide
+            hi = max(float(a.max()), 0.0 if bound is None else bound)
+            lo = min(float(a.min()), 0.0)
+            ax.hist(a, bins=np.linspace(lo, hi, HIST_BINS + 1) if hi > lo else HIST_BINS,
+                    color="C0")
+            if bound is not None:
                 ax.axvline(bound, color="C3", ls="--", lw=1, label=f"bound {bound:.0f} us")
                 ax.legend(fontsize="small")
             ax.set_title(f"{name} (n={a.size})", fontsize="medium")
