@@ -219,7 +219,8 @@ class BenchNode:
         self.fdir: dict[str, Any] = {}
         self.fsw_restarts = 0
         self.fault_counts: dict[str, int] = {
-            k: 0 for k in ("dropped", "delayed", "corrupted", "duplicated", "babbled")}
+            k: 0 for k in ("dropped", "delayed", "corrupted", "duplicated", "babbled",
+                           "failed_attempts")}  # failed_attempts: link_error retransmissions
         self.fault_rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
         self.sender_of = {m.name: (m.senders[0] if m.senders else "") for m in db.messages}
         self.name_of = {m.frame_id: m.name for m in db.messages}
@@ -498,6 +499,7 @@ class BenchNode:
         copies = 2 if fate.duplicate else 1
         if copies == 2:
             self.fault_counts["duplicated"] += 1
+        self.fault_counts["failed_attempts"] += fate.failed_attempts
         for _ in range(copies):
             self._put_on_bus(msg, name, ready_ns, realtime_ns, fate.failed_attempts)
         return msg
@@ -735,6 +737,7 @@ class BenchNode:
                 _flip(msg, fate.corrupt_bit)
             self.fault_counts["duplicated"] += fate.duplicate
             self.fault_counts["delayed"] += bool(fate.delay_ns)
+            self.fault_counts["failed_attempts"] += fate.failed_attempts
             for _copy in range(2 if fate.duplicate else 1):
                 bits = frame_bits(msg.arbitration_id, bytes(msg.data))
                 d = self.checker.check(msg)

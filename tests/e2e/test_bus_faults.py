@@ -89,6 +89,9 @@ def test_link_errors_and_bus_off_delay_commands_as_modelled(
         assert lat[k] == pytest.approx(base[k], abs=STUFFING_TOL_US), k
     faults = run.summary["faults"]
     assert [f["kind"] for f in faults] == ["link_error", "bus_off", "delay"]
+    # one failed attempt per THR_CMD_1 frame while the link error lasted, none without it
+    assert run.summary["fault_effects"]["failed_attempts"] == len(err_cycles)
+    assert ref.summary["fault_effects"]["failed_attempts"] == 0
 
 
 def _fault(kind: str, target: str, **params: object) -> str:

@@ -65,7 +65,8 @@ class Bench:
     def bench_status(self, sim_time_s: float) -> None:
         self.send(
             "BENCH_STATUS",
-            {"SimTime": sim_time_s, "ActiveFaults": 0, "Health": 0, "FaultCmdCounter": 15},
+            {"SimTime": sim_time_s, "ActiveFaults": 0, "Health": 0, "FaultCmdCounter": 15,
+             "FaultCmdRejected": 0},
         )
 
     def sync(self, k: int) -> dict[str, dict[str, float]]:
