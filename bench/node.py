@@ -543,15 +543,28 @@ class BenchNode:
                 t += step
 
     def _flush_wire(self, until_ns: int | None = None) -> dict[int, int]:
-        """Resolve bus arbitration; record frames in wire order. Returns seq -> rx time."""
+        """Resolve bus arbitration; record frames in wire order. Returns seq -> rx time.
+
+        A frame's failed attempts (link_error) go into the trace as error frames, stamped
+        at their end, in time order with the frames delivered meanwhile.
+        """
         rx: dict[int, int] = {}
+        entries: list[tuple[int, int, Any]] = []  # (time, 0 error / 1 frame, delivery)
         for d in self.arbiter.resolve(until_ns):
-            msg, tx, bits = self._wire_pending.pop(d.seq)
+            entries.extend((end - self._intermission_ns, 0, None) for _s, end in d.failed_ns)
             t_rx = d.end_ns - self._intermission_ns  # received at the end of EOF
-            self.trace.frame(msg, t_rx, tx=tx, t_ready_ns=d.ready_ns, t_start_ns=d.start_ns,
-                             bits=bits)
+            entries.append((t_rx, 1, d))
             rx[d.seq] = t_rx
             self._last_rx_ns = max(self._last_rx_ns, t_rx)
+        if any(kind == 0 for _t, kind, _d in entries):
+            entries.sort(key=lambda e: (e[0], e[1]))  # stable: frames keep their wire order
+        for t, _kind, d in entries:
+            if d is None:
+                self.trace.error_frame(t)
+                continue
+            msg, tx, bits = self._wire_pending.pop(d.seq)
+            self.trace.frame(msg, t, tx=tx, t_ready_ns=d.ready_ns, t_start_ns=d.start_ns,
+                             bits=bits)
         return rx
 
     def _send_queue(self, realtime_ns: int | None = None) -> None:

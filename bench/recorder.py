@@ -59,7 +59,11 @@ class TraceRecorder:
         """Record ``msg`` in the trace at ``t_ns`` (``tx`` = sent by the bench) and its timing row.
 
         ``t_rx_ns`` defaults to ``t_ns``; pass ``NAN`` when the reception time is unknown.
+        An error frame goes into the trace only: it is no message, frames.csv times messages.
         """
+        if msg.is_error_frame:
+            self.error_frame(t_ns)
+            return
         data = msg.data
         counter = data[1] & COUNTER_MASK if len(data) > 1 else -1
         self._frames.row([t_ready_ns / NS_PER_S, t_start_ns / NS_PER_S,
@@ -77,6 +81,12 @@ class TraceRecorder:
             channel=0,
         )
         self._writer.on_message_received(rec)
+        self.frames_written += 1
+
+    def error_frame(self, t_ns: int) -> None:
+        """An error frame on the bus at ``t_ns`` (ASC ``ErrorFrame`` line)."""
+        self._writer.on_message_received(
+            can.Message(timestamp=t_ns / NS_PER_S, is_error_frame=True, channel=0))
         self.frames_written += 1
 
     def event(self, t_ns: int, what: str, /, **fields: Any) -> None:

@@ -6,6 +6,7 @@ import csv
 import math
 from pathlib import Path
 
+import can
 import pytest
 
 from bench.bus.timing import failed_attempt_bits, wire_time_ns
@@ -89,9 +90,17 @@ def test_link_errors_and_bus_off_delay_commands_as_modelled(
         assert lat[k] == pytest.approx(base[k], abs=STUFFING_TOL_US), k
     faults = run.summary["faults"]
     assert [f["kind"] for f in faults] == ["link_error", "bus_off", "delay"]
-    # one failed attempt per THR_CMD_1 frame while the link error lasted, none without it
+    # one failed attempt per THR_CMD_1 frame while the link error lasted, none without it,
+    # each an error frame in the trace, in time order with the other frames
     assert run.summary["fault_effects"]["failed_attempts"] == len(err_cycles)
     assert ref.summary["fault_effects"]["failed_attempts"] == 0
+    trace = list(can.LogReader(str(run.out / "trace.asc")))
+    errors = [m.timestamp for m in trace if m.is_error_frame]
+    assert len(errors) == len(err_cycles)
+    assert all(ERR_FROM_S <= t < ERR_TO_S + PERIOD_S for t in errors)
+    stamps = [m.timestamp for m in trace]
+    assert stamps == sorted(stamps)
+    assert not any(m.is_error_frame for m in can.LogReader(str(ref.out / "trace.asc")))
 
 
 def _fault(kind: str, target: str, **params: object) -> str:
