@@ -550,13 +550,16 @@ class BenchNode:
         """
         rx: dict[int, int] = {}
         entries: list[tuple[int, int, Any]] = []  # (time, 0 error / 1 frame, delivery)
+        errors = False
         for d in self.arbiter.resolve(until_ns):
-            entries.extend((end - self._intermission_ns, 0, None) for _s, end in d.failed_ns)
+            if d.failed_ns:
+                errors = True
+                entries.extend((end - self._intermission_ns, 0, None) for _s, end in d.failed_ns)
             t_rx = d.end_ns - self._intermission_ns  # received at the end of EOF
             entries.append((t_rx, 1, d))
             rx[d.seq] = t_rx
             self._last_rx_ns = max(self._last_rx_ns, t_rx)
-        if any(kind == 0 for _t, kind, _d in entries):
+        if errors:
             entries.sort(key=lambda e: (e[0], e[1]))  # stable: frames keep their wire order
         for t, _kind, d in entries:
             if d is None:

@@ -26,7 +26,7 @@ from bench.faults import FaultSpec, parse_faults
 from bench.reference import KIND_STEP, KINDS, ReferenceParams, reference
 from bench.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
 from dbc import load_database
-from dbc.codec import BITRATE_ATTRIBUTE, bitrate_range_bps
+from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps, bitrate_range_bps
 from dbc.errors import ConfigError
 from dbc.schema import Table
 
@@ -507,7 +507,8 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     gyro, accel, st, nav = _sensors(root.table("sensors"))
 
     bt = root.table("bus", {})
-    rate_default, rate_lo, rate_hi = bitrate_range_bps(load_database())
+    db = load_database()
+    rate_default, (rate_lo, rate_hi) = bitrate_bps(db), bitrate_range_bps(db)
     bus = BusSpecCfg(
         bitrate_bps=bt.integer("bitrate_bps", rate_default, lo=rate_lo),
         fsw_response_delay_s=bt.number("fsw_response_delay_s", 0.001, lo=0.0, hi=0.1),

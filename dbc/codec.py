@@ -62,11 +62,19 @@ def cycle_time_ns(db: Database, name: str) -> int:
     return int(ms) * 1_000_000
 
 
-def bitrate_range_bps(db: Database) -> tuple[int, int, int]:
-    """(default, minimum, maximum) bitrate [bit/s] of the DBC's ``Baudrate`` definition."""
+def bitrate_bps(db: Database) -> int:
+    """The bus's bitrate [bit/s]: the DBC's ``Baudrate`` attribute value."""
+    try:
+        return int(str(db.dbc.attributes[BITRATE_ATTRIBUTE].value))  # type: ignore[union-attr]
+    except (AttributeError, KeyError, TypeError, ValueError) as exc:
+        raise IcdError(f"the DBC has no usable {BITRATE_ATTRIBUTE} attribute ({exc})") from exc
+
+
+def bitrate_range_bps(db: Database) -> tuple[int, int]:
+    """(minimum, maximum) bitrate [bit/s] of the DBC's ``Baudrate`` definition."""
     try:
         a = db.dbc.attribute_definitions[BITRATE_ATTRIBUTE]  # type: ignore[union-attr]
-        return int(str(a.default_value)), int(str(a.minimum)), int(str(a.maximum))
+        return int(str(a.minimum)), int(str(a.maximum))
     except (AttributeError, KeyError, TypeError, ValueError) as exc:
         raise IcdError(f"the DBC has no usable {BITRATE_ATTRIBUTE} definition ({exc})") from exc
 

@@ -92,8 +92,9 @@ from bench.analysis.reception import RX_LOG_COLUMNS, RX_LOG_FILE, fill_reception
 from bench.bus.rta import messages_from_dbc, response_times
 from bench.recorder import CHAIN_COLUMNS, FRAME_COLUMNS
 from dbc import load_database
+from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps
 from dbc.e2e import COUNTER_MODULUS
-from dbc.errors import ConfigError, RunError
+from dbc.errors import ConfigError, IcdError, RunError
 
 US_PER_S = 1e6
 MS_PER_S = 1e3
@@ -858,9 +859,9 @@ class RunTiming:
 def _dbc_bitrate_bps(db: Any) -> int:
     """The DBC's ``Baudrate`` attribute (bit/s)."""
     try:
-        return int(db.dbc.attributes["Baudrate"].value)
-    except (AttributeError, KeyError, TypeError) as exc:
-        raise ConfigError("DBC", "Baudrate", None, "a Baudrate attribute (bit/s)") from exc
+        return bitrate_bps(db)
+    except IcdError as exc:
+        raise ConfigError("DBC", BITRATE_ATTRIBUTE, None, "a Baudrate attribute (bit/s)") from exc
 
 
 def dbc_bitrate_bps(db: Any = None) -> int:

@@ -5,10 +5,7 @@ These fail before any process starts, so they run in-process through ``bench.cli
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 import uuid
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -17,15 +14,6 @@ from bench.cli import main
 
 QUICKSTART = str(Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml")
 EXIT_BAD_INPUT = 2
-
-
-@pytest.fixture
-def runtime(monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
-    """A private hilbus runtime directory, short enough for socket paths."""
-    d = Path(tempfile.mkdtemp(prefix="thil-"))
-    monkeypatch.setenv("XDG_RUNTIME_DIR", str(d))
-    yield d
-    shutil.rmtree(d, ignore_errors=True)
 
 
 def _run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:

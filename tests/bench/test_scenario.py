@@ -151,7 +151,7 @@ def test_a_bad_override_is_blamed_on_the_command_line() -> None:
 
 def test_bitrate_range_is_the_dbc_baudrate_definition() -> None:
     """bus.bitrate_bps: the DBC's Baudrate minimum and maximum are accepted, beyond refused."""
-    _default, lo, hi = bitrate_range_bps(load_database())
+    lo, hi = bitrate_range_bps(load_database())
     for ok in (lo, hi):
         assert load_scenario(QUICKSTART, [f"bus.bitrate_bps={ok}"]).bus.bitrate_bps == ok
     for bad in (lo - 1, hi + 1):

@@ -11,13 +11,11 @@ import copy
 import os
 import queue
 import select
-import shutil
 import signal
 import socket
 import stat
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 import uuid
@@ -42,15 +40,6 @@ DEADLINE_S = 30.0
 TIMEOUT_SLACK_S = 0.5
 BURST_N = 10_000
 QUEUE_OVERFILL_N = 200  # well past Linux's default of 10 queued datagrams per socket
-
-
-@pytest.fixture
-def runtime(monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
-    """A private, short runtime directory used as $XDG_RUNTIME_DIR."""
-    path = Path(tempfile.mkdtemp(prefix="thb-"))
-    monkeypatch.setenv("XDG_RUNTIME_DIR", str(path))
-    yield path
-    shutil.rmtree(path, ignore_errors=True)
 
 
 @pytest.fixture
