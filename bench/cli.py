@@ -47,6 +47,12 @@ def _fmt(x: Any, spec: str = ".4f", none: str = "n/a") -> str:
     return none if x is None else format(x, spec)
 
 
+def _settling_text(settling: float | None) -> str:
+    if settling is None:
+        return "not settled"
+    return f"{settling:.2f} s" + (" (never left the band)" if settling == 0.0 else "")
+
+
 def _print_summary(s: dict[str, Any], out: Path) -> None:
     lat = s["latency_us"]["sensor_to_command"]
     dm = s.get("deadline_misses") or {}
@@ -56,7 +62,7 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
         f"sim {s['sim_time_s']:.1f} s in {_fmt(s['wall_time_s'], '.2f')} s wall "
         f"(real-time factor {_fmt(s['realtime_factor'], '.1f')})",
         f"converged {s['converged']} | settling "
-        f"{'not settled' if settling is None else f'{settling:.2f} s'} | steady-state error "
+        f"{_settling_text(settling)} | steady-state error "
         f"{_fmt(s['steady_state_attitude_error_deg'])} deg, "
         f"{_fmt(s['steady_state_rate_error_deg_s'])} deg/s",
         f"propellant {s['propellant_kg'] * 1000:.1f} g | valve openings "
@@ -68,7 +74,7 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
     ]
     for e in s["expectations"]:
         lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {_fmt(e['value'])} "
-                     f"(max {e['max']})")
+                     f"(max {e['max']}{'; ' + e['note'] if e.get('note') else ''})")
     for w in s.get("warnings", []):
         lines.append(f"  WARNING {w}")
     if "error" in s:

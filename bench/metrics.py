@@ -93,9 +93,26 @@ def latency_summary(samples_ns: list[int]) -> dict[str, Any]:
     }
 
 
-def expectation(name: str, value: float | None, limit: float | None) -> dict[str, Any] | None:
-    """One expectation row: value, limit, pass (value <= limit); None if no limit set."""
+def expectation(
+    name: str, value: float | None, limit: float | None, note: str | None = None
+) -> dict[str, Any] | None:
+    """One expectation row: value, limit, pass (value <= limit), optional note; None if no limit."""
     if limit is None:
         return None
     ok = value is not None and bool(np.isfinite(value)) and value <= limit
-    return {"name": name, "value": value, "max": limit, "pass": ok}
+    row: dict[str, Any] = {"name": name, "value": value, "max": limit, "pass": ok}
+    if note is not None:
+        row["note"] = note
+    return row
+
+
+def settling_expectation(
+    name: str, value: float | None, limit: float | None, band: float | None, unit: str
+) -> dict[str, Any] | None:
+    """A settling-time row; a settling time of 0 is noted as never having left the band.
+
+    That pass says nothing about convergence from an offset (e.g. a tracking run that
+    starts on its reference): the note makes it visible in summary.json and on the console.
+    """
+    note = f"never outside the {band:g} {unit} band" if value == 0.0 and band else None
+    return expectation(name, value, limit, note)

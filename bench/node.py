@@ -38,7 +38,13 @@ from bench.faults import (
     fault_from_command,
     frame_fate,
 )
-from bench.metrics import expectation, latency_summary, pointing_metrics, settling_time_s
+from bench.metrics import (
+    expectation,
+    latency_summary,
+    pointing_metrics,
+    settling_expectation,
+    settling_time_s,
+)
 from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
 from bench.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
@@ -941,10 +947,19 @@ class BenchNode:
             settling_time_s(t_arr, pos, e.position_band_m, sc.manoeuvre_start_s)
             if e.position_band_m is not None else None
         )
+        rate_settling = (
+            settling_time_s(t_arr, np.asarray(self.tel_rate_err), e.rate_settling_band_deg_s,
+                            sc.manoeuvre_start_s)
+            if e.rate_settling_band_deg_s is not None else None
+        )
         exps = [
             x
             for x in (
-                expectation("settling_time_s", pm.settling_time_s, e.settling_time_s_max),
+                settling_expectation("settling_time_s", pm.settling_time_s,
+                                     e.settling_time_s_max, e.settling_band_deg, "deg"),
+                settling_expectation("rate_settling_time_s", rate_settling,
+                                     e.rate_settling_time_s_max, e.rate_settling_band_deg_s,
+                                     "deg/s"),
                 expectation(
                     "steady_state_attitude_error_deg",
                     pm.steady_state_attitude_error_deg,
@@ -958,8 +973,8 @@ class BenchNode:
                 expectation("steady_state_position_error_m", pos_ss,
                             e.steady_state_position_error_m_max),
                 expectation("final_position_error_m", pos_final, e.final_position_error_m_max),
-                expectation("position_settling_time_s", pos_settling,
-                            e.position_settling_time_s_max),
+                settling_expectation("position_settling_time_s", pos_settling,
+                                     e.position_settling_time_s_max, e.position_band_m, "m"),
             )
             if x is not None
         ]
@@ -986,6 +1001,8 @@ class BenchNode:
             "steady_state_position_error_m": pos_ss,
             "position_band_m": e.position_band_m,
             "position_settling_time_s": pos_settling,
+            "rate_settling_band_deg_s": e.rate_settling_band_deg_s,
+            "rate_settling_time_s": rate_settling,
             "reference_kind": sc.reference.kind,
             "translation": sc.dynamics.translation,
             "valve_model": sc.valve.model,

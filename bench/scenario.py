@@ -162,6 +162,8 @@ class Expectations:
     final_position_error_m_max: float | None = None
     position_band_m: float | None = None
     position_settling_time_s_max: float | None = None
+    rate_settling_band_deg_s: float | None = None
+    rate_settling_time_s_max: float | None = None
 
 
 @dataclass(frozen=True)
@@ -568,10 +570,18 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         position_band_m=et.number("position_band_m", lo=0.0, lo_open=True)
         if et.has("position_band_m") else None,
         position_settling_time_s_max=_opt(et, "position_settling_time_s_max"),
+        rate_settling_band_deg_s=et.number("rate_settling_band_deg_s", lo=0.0, lo_open=True)
+        if et.has("rate_settling_band_deg_s") else None,
+        rate_settling_time_s_max=_opt(et, "rate_settling_time_s_max"),
         steady_state_window_s=et.number(
             "steady_state_window_s", 10.0, lo=0.0, lo_open=True, hi=duration_s
         ),
     )
+    for key, band in (("position_settling_time_s_max", "position_band_m"),
+                      ("rate_settling_time_s_max", "rate_settling_band_deg_s")):
+        if et.has(key) and not et.has(band):
+            raise et.error(key, et.raw(key, None), f"set together with {band} (the band it "
+                           "settles into)")
     et.done()
     root.done()
     return Scenario(

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from bench.metrics import expectation, latency_summary, pointing_metrics, settling_time_s
+from bench.metrics import (
+    expectation,
+    latency_summary,
+    pointing_metrics,
+    settling_expectation,
+    settling_time_s,
+)
 
 BAND_DEG = 0.5
 WINDOW_S = 10.0
@@ -62,3 +68,16 @@ def test_position_settling_time_known_answer() -> None:
     assert settling_time_s(t, err, 0.05) == 3.0
     assert settling_time_s(t, err, 0.05, t_start_s=1.0) == 2.0
     assert settling_time_s(t, np.array([0.0, 0.0, 0.0, 0.0, 0.1]), 0.05) is None
+
+
+def test_settling_of_zero_is_noted_as_never_outside() -> None:
+    """A zero settling time (the error never left its band) carries a note; others none."""
+    t = np.arange(0.0, 5.0, DT_S)
+    inside = settling_time_s(t, np.full_like(t, 0.1), BAND_DEG)
+    row = settling_expectation("settling_time_s", inside, 10.0, BAND_DEG, "deg")
+    assert inside == 0.0 and row is not None and row["pass"]
+    assert row["note"] == f"never outside the {BAND_DEG:g} deg band"
+    err = 30.0 * np.exp(-t / TAU_S)
+    later = settling_expectation("settling_time_s", settling_time_s(t, err, 5.0), 10.0, 5.0, "deg")
+    assert later is not None and later["value"] > 0.0 and "note" not in later
+    assert settling_expectation("x", 0.0, None, BAND_DEG, "deg") is None

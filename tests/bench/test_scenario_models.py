@@ -164,3 +164,25 @@ def test_throttled_plant_and_fsw_config() -> None:
     plant.advance_to(CONTROL_PERIOD_NS)
     impulse = plant.thrusters.impulse_Ns[0]
     assert impulse == pytest.approx(CONTROL_PERIOD_NS / 2 / NS_PER_S * 15.0, rel=REL_TOL)
+
+
+def test_rate_settling_expectation_parses() -> None:
+    """rate_settling_band_deg_s and rate_settling_time_s_max reach the expectations."""
+    d = _data()
+    d["expectations"].update(rate_settling_band_deg_s=0.2, rate_settling_time_s_max=5.0)
+    e = parse_scenario(d, "r.toml").expectations
+    assert (e.rate_settling_band_deg_s, e.rate_settling_time_s_max) == (0.2, 5.0)
+
+
+@pytest.mark.parametrize(
+    ("key", "band"),
+    [("rate_settling_time_s_max", "rate_settling_band_deg_s"),
+     ("position_settling_time_s_max", "position_band_m")],
+)
+def test_settling_limit_without_its_band_is_named(key: str, band: str) -> None:
+    """A settling-time limit without the band it settles into: ConfigError naming both."""
+    d = _data()
+    d["expectations"][key] = 5.0
+    with pytest.raises(ConfigError) as info:
+        parse_scenario(d, "b.toml")
+    assert info.value.key == f"expectations.{key}" and band in str(info.value)
