@@ -34,6 +34,7 @@ from bench.faults import (
     BUS_KINDS,
     NO_FATE,
     REALTIME_BUS_KINDS,
+    Fate,
     FaultSpec,
     fault_from_command,
     frame_fate,
@@ -750,14 +751,9 @@ class BenchNode:
             name = self.name_of.get(msg.arbitration_id)
             fate = (frame_fate(self.active_faults_specs, name, self.sender_of[name], self.fault_rng)
                     if self.active_faults and name is not None else NO_FATE)
-            if fate.drop:
-                self.fault_counts["dropped"] += 1
+            if not self._take_rx_fate(msg, fate):
                 lost += bool(name and name.startswith("THR_CMD_"))
                 continue
-            if fate.corrupt_bit is not None:
-                self.fault_counts["corrupted"] += 1
-                _flip(msg, fate.corrupt_bit)
-            self.fault_counts["duplicated"] += fate.duplicate
             self.fault_counts["delayed"] += bool(fate.delay_ns)
             self.fault_counts["failed_attempts"] += fate.failed_attempts
             for _copy in range(2 if fate.duplicate else 1):
@@ -883,16 +879,26 @@ class BenchNode:
         if self.active_faults and name is not None and self.sender_of[name] != BENCH_NODE:
             fate = frame_fate(self.active_faults_specs, name, self.sender_of[name],
                               self.fault_rng)
-            if fate.drop:
-                self.fault_counts["dropped"] += 1
+            if not self._take_rx_fate(msg, fate):
                 return
-            if fate.corrupt_bit is not None:
-                self.fault_counts["corrupted"] += 1
-                _flip(msg, fate.corrupt_bit)
             if fate.duplicate:
-                self.fault_counts["duplicated"] += 1
                 self._realtime_frame(msg, clock)
         self._realtime_frame(msg, clock)
+
+    def _take_rx_fate(self, msg: can.Message, fate: Fate) -> bool:
+        """Count the bus faults' ``fate`` of a received frame and corrupt ``msg`` as it says.
+
+        Shared by both run modes; False when the frame is dropped (never seen). Duplicates
+        are counted here and delivered twice by the caller.
+        """
+        if fate.drop:
+            self.fault_counts["dropped"] += 1
+            return False
+        if fate.corrupt_bit is not None:
+            self.fault_counts["corrupted"] += 1
+            _flip(msg, fate.corrupt_bit)
+        self.fault_counts["duplicated"] += fate.duplicate
+        return True
 
     def _realtime_frame(self, msg: can.Message, clock: Clock) -> None:
         """Trace every frame heard (as a CAN logger would, bad ones too), act on good ones."""
