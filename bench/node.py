@@ -674,7 +674,11 @@ class BenchNode:
 
     # -- lockstep ----------------------------------------------------------------
     def wait_for_fsw(self) -> None:
-        """Wait for the flight software's first valid frame (its boot heartbeat)."""
+        """Wait for the flight software's first valid frame (its boot heartbeat).
+
+        Every frame heard meanwhile goes into the trace at t = 0 (as a CAN logger records
+        what precedes a run), bad ones too; only the valid one ends the wait.
+        """
         deadline = time.monotonic() + self.sc.bus.startup_timeout_s
         while time.monotonic() < deadline:
             if self.fsw_alive is not None and not self.fsw_alive():
@@ -686,8 +690,9 @@ class BenchNode:
             if msg is None:
                 continue
             d = self.checker.check(msg)
+            self.trace.frame(msg, 0, tx=False, t_rx_ns=0 if d is not None else NAN,
+                             bits=frame_bits(msg.arbitration_id, bytes(msg.data)))
             if d is not None:
-                self.trace.frame(msg, 0, tx=False)
                 self._on_fsw_frame(d.name, d.signals, d.counter)
                 return
         raise RunError(
