@@ -76,6 +76,7 @@ import scipy.sparse as sp
 
 from dbc.errors import ConfigError
 from flight_sw.allocation.base import AllocationResult
+from flight_sw.allocation.osqp_lean import LeanOsqp
 
 MAX_DEMAND_DIM = 6
 # Singular values below RANK_RTOL × the largest count as zero (rank, least-norm solutions).
@@ -498,7 +499,7 @@ class BoundedQpAllocator:
         self._range_T = range_basis_T(b_a)
         self._attained_tol = attained_tolerance(b_a, self._lo_a, self._hi_a)
         k = self._avail.size
-        self._solver: Any = None
+        self._osqp: Any = None
         if k:
             gram_diag = np.sum(self._b_w * self._b_w, axis=0)
             eps = params.regularization * float(np.mean(gram_diag))
@@ -508,8 +509,8 @@ class BoundedQpAllocator:
             )
             self._l = np.concatenate([np.zeros(m), self._lo_a])
             self._u = np.concatenate([np.zeros(m), self._hi_a])
-            self._solver = osqp.OSQP()
-            self._solver.setup(
+            problem = osqp.OSQP()
+            problem.setup(
                 p,
                 np.zeros(k + m),
                 a,
@@ -517,6 +518,7 @@ class BoundedQpAllocator:
                 self._u,
                 **osqp_settings(params.warm_start, stage_one=True),
             )
+            self._osqp = LeanOsqp(problem)
             self._m_mat = self._b_w.T @ self._b_w + eps * np.eye(k)
             self._definite = eps > 0.0
         # the previous call's exact active set: the warm start of box_qp when OSQP stopped
@@ -555,10 +557,10 @@ class BoundedQpAllocator:
         m = d.shape[0]
         self._l[:m] = d
         self._u[:m] = d
-        self._solver.update(l=self._l, u=self._u)
-        res = self._solver.solve(raise_error=False)
-        converged = int(res.info.status_val) == int(osqp.SolverStatus.OSQP_SOLVED)
-        x = np.asarray(res.x, dtype=float)
+        self._osqp.update(l=self._l, u=self._u)
+        res = self._osqp.solve()
+        converged = res.solved
+        x = res.x
         k = self._avail.size
         t_qp = x[:k] if x.shape == (k + m,) and np.all(np.isfinite(x)) else np.zeros(k)
         t_qp = np.minimum(np.maximum(t_qp, self._lo_a), self._hi_a)

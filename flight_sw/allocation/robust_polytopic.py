@@ -91,6 +91,7 @@ import scipy.sparse as sp
 
 from dbc.errors import ConfigError
 from flight_sw.allocation.base import AllocationResult
+from flight_sw.allocation.osqp_lean import LeanOsqp
 from flight_sw.allocation.qp_osqp import (
     ACTIVE_RTOL,
     DEFAULT_REGULARIZATION,
@@ -268,8 +269,9 @@ class VertexMinimaxSolver:
         self._u = np.concatenate([np.zeros(n_vert), hi])
         self._q = np.zeros(k + 1)
         self._q[k] = 1.0
-        self._solver: Any = osqp.OSQP()
-        self._solver.setup(p, self._q, a, self._l, self._u, **osqp_settings(warm_start))
+        problem = osqp.OSQP()
+        problem.setup(p, self._q, a, self._l, self._u, **osqp_settings(warm_start))
+        self._osqp = LeanOsqp(problem)
 
     def _objective(self, t: np.ndarray, v: np.ndarray) -> float:
         r = self._v @ t - v[None]
@@ -359,15 +361,15 @@ class VertexMinimaxSolver:
             self._u[:n_vert] = g @ t - f
             self._q[:k] = -(h @ t)
             self._q[k] = 1.0 - prox * obj
-            self._solver.update(
+            self._osqp.update(
                 Px=self._p_dense[self._p_rows, self._p_cols],
                 Ax=self._a_dense[self._a_rows, self._a_cols],
                 q=self._q,
                 l=self._l,
                 u=self._u,
             )
-            res = self._solver.solve(raise_error=False)
-            x = np.asarray(res.x, dtype=float)
+            res = self._osqp.solve()
+            x = res.x
             if x.shape != (k + 1,) or not np.all(np.isfinite(x)):
                 break
             t_new = np.minimum(np.maximum(x[:k], lo), hi)
@@ -376,7 +378,7 @@ class VertexMinimaxSolver:
             decrease = obj - model
             if decrease <= SQP_RTOL * obj + self._f_floor:
                 break
-            y = np.maximum(np.asarray(res.y, dtype=float)[:n_vert], 0.0)
+            y = np.maximum(res.y[:n_vert], 0.0)
             if float(y.sum()) > 0.0:
                 lam = y / float(y.sum())
             alpha = 1.0
