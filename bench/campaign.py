@@ -26,11 +26,6 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
 from bench.scenario import load_scenario
 from dbc.errors import ConfigError, RunError
 
@@ -118,6 +113,8 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
 
 
 def _plot(rows: list[dict[str, Any]], path: Path) -> None:
+    from bench.plots import plt  # matplotlib is loaded only when there is something to plot
+
     fig, ax = plt.subplots(figsize=(9, 4))
     width = 0.4
     kinds = [k for k in KINDS if any(r["kind"] == k for r in rows)]

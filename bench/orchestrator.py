@@ -14,6 +14,7 @@ software dies.
 from __future__ import annotations
 
 import ctypes
+import gc
 import json
 import os
 import selectors
@@ -33,7 +34,6 @@ import numpy as np
 from bench.analysis.reception import RX_LOG_FILE
 from bench.metrics import pointing_metrics
 from bench.node import BenchNode, frame_table, merge_counts
-from bench.plots import plot_run
 from bench.recorder import write_summary
 from bench.scenario import Scenario
 from dbc import load_database
@@ -214,6 +214,12 @@ def _run_bench(
             log.close()
             (out / "fsw.pid").write_text(f"{proc.pid}\n", encoding="utf-8")
             node.fsw_alive = lambda: proc is not None and proc.poll() is None
+        # Everything built so far lives for the whole run: keep it out of the cyclic
+        # garbage collector's passes. Without this, a full collection over it stops the
+        # bench for ~100 ms a few seconds in, which in realtime trips the flight software's
+        # sensor watchdog (safe mode) every run.
+        gc.collect()
+        gc.freeze()
         if opts.mode == "lockstep":
             node.run_lockstep(opts.duration_s)
         else:
@@ -265,7 +271,7 @@ def _run_bench(
                 error = RefusedConfigError("the flight software", summary["fsw"]["refused"])
         summary["passed"] = False
     write_summary(out / "summary.json", summary)
-    plot_run(out, sc.expectations.settling_band_deg)
+    _plot(out, sc)
     if error is not None and not isinstance(error, Exception):
         raise error  # KeyboardInterrupt and friends, after the folder is complete
     if isinstance(error, RefusedConfigError):
@@ -274,6 +280,15 @@ def _run_bench(
         tail = "".join(f"\n  fsw.log: {x}" for x in summary["fsw"].get("log_tail", []))
         raise RunError(f"run failed ({summary['error']}); run folder: {out}{tail}") from error
     return summary
+
+
+def _plot(out: Path, sc: Scenario) -> None:
+    """The run's PNG plots. matplotlib is imported here, after the run: the bench process
+    does not carry its heap (tens of thousands of objects the garbage collector would walk)
+    while it runs."""
+    from bench.plots import plot_run
+
+    plot_run(out, sc.expectations.settling_band_deg)
 
 
 def check_bus(spec: str) -> None:
@@ -416,7 +431,7 @@ def partial_summary(sc: Scenario, opts: RunOptions, why: str) -> dict[str, Any]:
     merge_counts(frames, other, "FSW", summary["fsw"].get("sent", {}),
                  summary["fsw"].get("received", {}))
     write_summary(out / "summary.json", summary)
-    plot_run(out, sc.expectations.settling_band_deg)
+    _plot(out, sc)
     return summary
 
 

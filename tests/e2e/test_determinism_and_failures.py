@@ -19,6 +19,7 @@ CONTROL_PERIOD_S = 0.02
 WATCHDOG_PERIODS = 3
 EXIT_BAD_INPUT = 2
 REALTIME_S = "3"
+QUICKSTART_S = 60.0  # the scenario's own duration
 
 
 def test_same_seed_gives_identical_trace_other_seed_differs(
@@ -113,6 +114,19 @@ def test_realtime_run_measures_latency(tmp_path: Path, runtime_dir: Path) -> Non
     assert lat["n"] > 0 and lat["p50"] > 0
     assert {"bench_late", "fsw_overruns"} <= set(s["deadline_misses"])
     assert s["wall_time_s"] >= float(REALTIME_S)
+
+
+def test_realtime_quickstart_converges_over_its_60_s(tmp_path: Path, runtime_dir: Path) -> None:
+    """The quickstart in realtime for its whole 60 s: converges, every expectation holds."""
+    r = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--mode", "realtime"],
+                tmp_path / "run", runtime_dir)
+    s = r.summary
+    assert s["sim_time_s"] == pytest.approx(QUICKSTART_S, abs=CONTROL_PERIOD_S)
+    assert s["converged"], s["expectations"]
+    assert s["expectations"] and all(e["pass"] for e in s["expectations"]), s["expectations"]
+    assert s["fsw"]["mode"] != "SAFE"
+    assert s["latency_us"]["sensor_to_command"]["p99"] is not None
+    assert "total" in s["deadline_misses"]
 
 
 RESTART_AT_CYCLE = 50
