@@ -148,8 +148,10 @@ def run_scenario(
             signal.signal(signal.SIGTERM, _terminate)
             (out / "bench.pid").write_text(f"{os.getpid()}\n", encoding="utf-8")
             _run_bench(sc, opts, progress, ready, config)
-        except ConfigError:
+        except ConfigError as exc:
             code = EXIT_CHILD_BAD_INPUT
+            if not (out / "summary.json").exists():  # refused before the run: say why
+                partial_summary(sc, opts, f"bad input: {exc}", refused=str(exc))
         except RunError:
             code = EXIT_CHILD_RUN_ERROR
         except BaseException as exc:
@@ -176,6 +178,8 @@ def run_scenario(
         raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     if os.WEXITSTATUS(status) == EXIT_CHILD_BAD_INPUT:
+        if summary.get("refused"):
+            raise RefusedConfigError("the bench", summary["refused"])
         raise RefusedConfigError("the flight software", summary["fsw"]["refused"])
     if os.WEXITSTATUS(status) != EXIT_CHILD_OK:
         tail = "".join(f"\n  fsw.log: {x}" for x in (summary.get("fsw") or {}).get("log_tail", []))
@@ -378,8 +382,13 @@ def _wait_for_fsw_exit(out: Path) -> None:
         os.close(fd)
 
 
-def partial_summary(sc: Scenario, opts: RunOptions, why: str) -> dict[str, Any]:
-    """summary.json rebuilt from the files a killed bench left behind (flushed as it ran)."""
+def partial_summary(
+    sc: Scenario, opts: RunOptions, why: str, refused: str | None = None
+) -> dict[str, Any]:
+    """summary.json rebuilt from the files a killed bench left behind (flushed as it ran).
+
+    ``refused``: the bench refused its input before the run (the error, naming the key).
+    """
     out = opts.out
     _wait_for_fsw_exit(out)
     db = load_database()
@@ -427,6 +436,8 @@ def partial_summary(sc: Scenario, opts: RunOptions, why: str) -> dict[str, Any]:
         "deadline_misses": None, "faults": faults, "expectations": [], "passed": False,
         "error": why, "partial": True,
     }
+    if refused is not None:
+        summary["refused"] = refused
     summary["fsw"] = _fsw_report(out / "fsw_stats.json", None, out)
     merge_counts(frames, other, "FSW", summary["fsw"].get("sent", {}),
                  summary["fsw"].get("received", {}))

@@ -22,6 +22,8 @@ ERROR_FLOOR_DEG = 1e-4
 
 
 def _read_csv(path: Path) -> dict[str, np.ndarray]:
+    if not path.exists():  # a run refused or killed before its first row
+        return {}
     with open(path, newline="", encoding="utf-8") as f:
         rows = list(csv.reader(f))
     if not rows:

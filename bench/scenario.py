@@ -20,7 +20,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from cantools.database.can import Database
+
 from bench.dynamics.hcw import SEED000_ORBIT_RADIUS_M
+from bench.dynamics.rigid_body import MassProperties
 from bench.environment.disturbance import FORCE_FRAMES, DisturbanceParams, Sinusoid
 from bench.faults import FaultSpec, parse_faults
 from bench.reference import KIND_STEP, KINDS, ReferenceParams, reference
@@ -290,22 +293,16 @@ def _quat(t: Table, key: str) -> Quat:
 
 
 def _mass(t: Table) -> MassSpec:
+    """Mass and inertia, checked as the plant will use them (:class:`MassProperties`:
+    symmetric, positive definite, principal moments obeying the triangle inequality), so a
+    body that cannot exist is refused here, naming the key, before any process starts."""
     m = t.number("mass_kg", lo=0.0, lo_open=True)
     J = t.matrix3("inertia_B_kgm2")
-    for i in range(3):
-        for j in range(3):
-            if abs(J[i][j] - J[j][i]) > 1e-9 * max(1.0, abs(J[i][j])):
-                raise t.error("inertia_B_kgm2", [list(r) for r in J], "a symmetric matrix")
-    # positive definite: leading principal minors (Sylvester)
-    m1 = J[0][0]
-    m2 = J[0][0] * J[1][1] - J[0][1] * J[1][0]
-    m3 = (
-        J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1])
-        - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0])
-        + J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0])
-    )
-    if min(m1, m2, m3) <= 0:
-        raise t.error("inertia_B_kgm2", [list(r) for r in J], "a positive-definite matrix")
+    try:
+        MassProperties(m, J)
+    except ConfigError as exc:
+        raise t.error(exc.key, [list(r) for r in J] if exc.key == "inertia_B_kgm2" else m,
+                      exc.expected) from exc
     return MassSpec(m, J)  # type: ignore[arg-type]
 
 
@@ -360,7 +357,26 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
     return tuple(geo), v
 
 
-def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec, RelNavSpec | None]:
+def _icd_range(db: Database, message: str, signals: tuple[str, ...]) -> float:
+    """The largest symmetric range the DBC's ``signals`` of ``message`` can carry."""
+    msg = db.get_message_by_name(message)
+    spans = [msg.get_signal_by_name(n) for n in signals]
+    return min(min(-float(x.minimum), float(x.maximum)) for x in spans)  # type: ignore[arg-type]
+
+
+def _sensor_range(t: Table, key: str, db: Database, message: str, axes: str) -> float:
+    """A sensor's measurement range, no wider than its frame's signals in the DBC (the ICD)."""
+    limit = _icd_range(db, message, tuple(f"{axes}{c}" for c in "XYZ"))
+    value = t.number(key, lo=0.0, lo_open=True)
+    if value > limit:
+        raise t.error(key, value, f"at most {limit:g} ({message}.{axes}X/Y/Z carry "
+                      f"[-{limit:g}, {limit:g}] in the DBC, the interface control document)")
+    return value
+
+
+def _sensors(
+    t: Table, db: Database
+) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec, RelNavSpec | None]:
     g = t.table("gyro")
     gyro = GyroSpec(
         arw_rad_sqrt_s=g.number("arw_deg_sqrt_h", lo=0.0) * DEG_RAD / SQRT_HOUR_S,
@@ -370,7 +386,7 @@ def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec, RelNavSpec
         / 3600.0
         / SQRT_HOUR_S,
         lsb_rad_s=g.number("lsb_rad_s", lo=0.0),
-        range_rad_s=g.number("range_rad_s", lo=0.0, lo_open=True),
+        range_rad_s=_sensor_range(g, "range_rad_s", db, "IMU_RATE", "Rate"),
     )
     g.done()
     a = t.table("accelerometer")
@@ -378,7 +394,7 @@ def _sensors(t: Table) -> tuple[GyroSpec, AccelSpec, StarTrackerSpec, RelNavSpec
         vrw_m_s_sqrt_s=a.number("vrw_m_s_sqrt_h", lo=0.0) / SQRT_HOUR_S,
         bias_m_s2=tuple(x * 1e-6 * 9.80665 for x in a.vector("bias_ug", 3)),  # type: ignore[arg-type]
         lsb_m_s2=a.number("lsb_m_s2", lo=0.0),
-        range_m_s2=a.number("range_m_s2", lo=0.0, lo_open=True),
+        range_m_s2=_sensor_range(a, "range_m_s2", db, "IMU_ACCEL", "Accel"),
     )
     a.done()
     s = t.table("star_tracker")
@@ -506,10 +522,10 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     vt.done()
 
     thrusters, valve = _thrusters(root.table("thrusters"))
-    gyro, accel, st, nav = _sensors(root.table("sensors"))
+    db = load_database()
+    gyro, accel, st, nav = _sensors(root.table("sensors"), db)
 
     bt = root.table("bus", {})
-    db = load_database()
     rate_default, (rate_lo, rate_hi) = bitrate_bps(db), bitrate_range_bps(db)
     bus = BusSpecCfg(
         bitrate_bps=bt.integer("bitrate_bps", rate_default, lo=rate_lo),

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import json
+import uuid
 from pathlib import Path
 
+import pytest
+
+from bench import orchestrator
 from bench.orchestrator import duration_warnings
 from bench.scenario import load_scenario
+from dbc.errors import ConfigError, RefusedConfigError
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 QUICKSTART = SCENARIOS / "quickstart.toml"
@@ -47,3 +53,23 @@ def test_run_that_ends_before_scheduled_faults_and_events_is_warned(tmp_path: Pa
     (event,) = capture.events
     (w,) = [w for w in duration_warnings(capture, event.t_s) if "never act" in w]
     assert "[[events]]" in w and f"capture at {event.t_s:g} s" in w
+
+
+def test_bench_refusing_its_input_before_the_run_says_why(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A ConfigError inside the bench process: RefusedConfigError naming it, summary.json too."""
+    bad = ConfigError("q.toml", "vehicle.k", 1.0, "something the bench takes")
+
+    def refuse(*_args: object, **_kwargs: object) -> None:
+        raise bad
+
+    monkeypatch.setattr(orchestrator, "BenchNode", refuse)
+    sc = load_scenario(QUICKSTART)
+    opts = orchestrator.RunOptions(mode="lockstep", bus=f"virtual:r-{uuid.uuid4().hex}",
+                                   seed=1, out=tmp_path / "run", duration_s=1.0, fsw_cmd=None)
+    with pytest.raises(RefusedConfigError) as info:
+        orchestrator.run_scenario(sc, opts)
+    assert str(bad) in str(info.value) and "the bench" in str(info.value)
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text(encoding="utf-8"))
+    assert summary["refused"] == str(bad) and summary["passed"] is False

@@ -60,7 +60,15 @@ def test_euler_target_known_answer() -> None:
             [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]],
             "vehicle.inertia_B_kgm2",
         ),
+        (  # symmetric, positive definite, but no body has it (triangle inequality)
+            "vehicle",
+            "inertia_B_kgm2",
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 5.0]],
+            "vehicle.inertia_B_kgm2",
+        ),
         ("scenario", "duration_s", "60", "scenario.duration_s"),
+        ("sensors.gyro", "range_rad_s", 10.0, "sensors.gyro.range_rad_s"),  # beyond the DBC
+        ("sensors.accelerometer", "range_m_s2", 5.0, "sensors.accelerometer.range_m_s2"),
         (
             "sensors.star_tracker",
             "boresight_B",
