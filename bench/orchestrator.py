@@ -47,6 +47,7 @@ DEFAULT_FSW_CMD = (
 )
 FSW_TERM_TIMEOUT_S = 5.0
 EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH, EXIT_CHILD_BAD_INPUT = 0, 3, 4, 5
+EXIT_CHILD_INTERRUPTED = 6  # Ctrl-C: the run folder is complete, the parent re-raises it
 FSW_EXIT_BAD_INPUT = 2  # our flight software's exit code for a configuration it refuses
 FSW_ERROR_MARK = "error:"  # how its refusal line reads in fsw.log
 PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
@@ -154,6 +155,8 @@ def run_scenario(
                 partial_summary(sc, opts, f"bad input: {exc}", refused=str(exc))
         except RunError:
             code = EXIT_CHILD_RUN_ERROR
+        except KeyboardInterrupt:
+            code = EXIT_CHILD_INTERRUPTED
         except BaseException as exc:
             code = EXIT_CHILD_CRASH
             if not (out / "summary.json").exists() and not isinstance(exc, KeyboardInterrupt):
@@ -177,6 +180,8 @@ def run_scenario(
             "writing summary.json (see its traceback above)")
         raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    if os.WEXITSTATUS(status) == EXIT_CHILD_INTERRUPTED:
+        raise KeyboardInterrupt  # after the bench completed the run folder
     if os.WEXITSTATUS(status) == EXIT_CHILD_BAD_INPUT:
         if summary.get("refused"):
             raise RefusedConfigError("the bench", summary["refused"])
@@ -234,6 +239,9 @@ def _run_bench(
         fsw_rc = _stop(proc) if proc is not None else None
         (out / "fsw.pid").unlink(missing_ok=True)
         bus.shutdown()
+    if isinstance(error, (KeyboardInterrupt, Terminated)):
+        node.trace.event(node.plant.t_ns, "run_interrupted",
+                         by="SIGINT" if isinstance(error, KeyboardInterrupt) else str(error))
     summary = node.close(opts.duration_s if error is None else node.plant.t_ns / 1e9)
     summary["fsw"] = _fsw_report(stats, fsw_rc, out)
     merge_counts(summary["frames"], summary["rejected_other"], "FSW",

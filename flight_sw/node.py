@@ -160,9 +160,14 @@ class FlightNode:
 
     # -- signals -----------------------------------------------------------------
     def install_signal_handlers(self) -> None:
-        """SIGTERM / SIGINT end the loop at once (even inside a blocking receive)."""
+        """SIGTERM / SIGINT end the loop at once (even inside a blocking receive).
+
+        A second signal while stopping is ignored, so the statistics file is still written.
+        """
 
         def _handler(signum: int, frame: FrameType | None) -> None:
+            if self._stop:  # already stopping (e.g. Ctrl-C, then the bench's SIGTERM):
+                return  # let the statistics be written
             self._stop = True
             raise StopRequested(signum)
 

@@ -79,10 +79,14 @@ PROGRESS_DEADLINE_S = 120.0
 
 @contextlib.contextmanager
 def running(
-    args: list[str], out: Path, runtime_dir: Path, min_percent: float = 0.0
+    args: list[str], out: Path, runtime_dir: Path, min_percent: float = 0.0,
+    own_group: bool = False,
 ) -> Iterator[subprocess.Popen[str]]:
     """``thruster-hil ARGS --out OUT`` in the background, entered once its progress passes
-    ``min_percent``; on exit it is waited for (and killed if a test failed meanwhile)."""
+    ``min_percent``; on exit it is waited for (and killed if a test failed meanwhile).
+
+    ``own_group``: in a process group of its own (its pid), as a terminal's foreground job,
+    so that a signal can go to all its processes at once (``os.killpg``)."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
     p = subprocess.Popen(
         [sys.executable, "-m", "bench.cli", *args, "--out", str(out)],
@@ -91,6 +95,7 @@ def running(
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         text=True,
+        start_new_session=own_group,
     )
     try:
         assert p.stderr is not None
