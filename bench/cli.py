@@ -72,6 +72,9 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
         f"flight-software overruns {dm.get('fsw_overruns', 0)}, "
         f"bench late {dm.get('bench_late', 0)}",
     ]
+    if not s["converged"]:  # a run fails on this alone, with or without expectations
+        lines.append(f"  FAIL converged: the attitude error did not end inside the "
+                     f"{_fmt(s.get('settling_band_deg'), 'g')} deg settling band")
     for e in s["expectations"]:
         lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {_fmt(e['value'])} "
                      f"(max {e['max']}{'; ' + e['note'] if e.get('note') else ''})")
