@@ -5,8 +5,8 @@ realtime), ``bench SCENARIO`` (the bench alone, for external flight software or 
 on the same bus), ``report RUN_DIR`` (redraw plots, print the summary), ``timing RUN_DIR``
 (per-message timing, chains, bus load, worst-case bounds; ``timing --live --bus SPEC``
 measures a running bus). Exit codes: 0 pass, 1 the run's expectations failed (``timing
---strict``: a measured latency above its bound), 2 bad input (scenario, options), 3 run
-error.
+--strict``: a measured latency above its bound, or a message sent but never received), 2
+bad input (scenario, options), 3 run error, 130 interrupted.
 """
 
 from __future__ import annotations
@@ -184,7 +184,7 @@ def _cmd_timing(args: argparse.Namespace) -> int:
             print(format_report(rt))
             for p in written:
                 print(f"wrote {p}")
-    return EXIT_FAILED if args.strict and rt.flagged() else EXIT_OK
+    return EXIT_FAILED if args.strict and (rt.flagged() or rt.unheard()) else EXIT_OK
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -312,7 +312,8 @@ def _add_timing_parser(sub: Any) -> None:
     t.add_argument(
         "--strict",
         action="store_true",
-        help="exit 1 if a measured latency is above its worst-case bound",
+        help="exit 1 if a measured latency is above its worst-case bound, or a message "
+        "its sender sent never reached the trace",
     )
     t.add_argument("--live", action="store_true", help="listen to a running bus instead")
     t.add_argument("--bus", help="--live: bus spec INTERFACE:CHANNEL (default as for run)")

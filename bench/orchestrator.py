@@ -33,7 +33,7 @@ import numpy as np
 
 from bench.analysis.reception import RX_LOG_FILE
 from bench.metrics import pointing_metrics
-from bench.node import BenchNode, frame_table, merge_counts
+from bench.node import BenchNode, frame_table, merge_counts, zero_unheard
 from bench.recorder import write_summary
 from bench.scenario import Scenario
 from dbc import load_database
@@ -246,6 +246,8 @@ def _run_bench(
     summary["fsw"] = _fsw_report(stats, fsw_rc, out)
     merge_counts(summary["frames"], summary["rejected_other"], "FSW",
                  summary["fsw"].get("sent", {}), summary["fsw"].get("received", {}))
+    fsw_heard = {"FSW"} if "received" in summary["fsw"] else set()
+    zero_unheard(summary["frames"], {"BENCH"} | fsw_heard)
     if isinstance(summary["deadline_misses"], dict):
         summary["deadline_misses"]["fsw_overruns"] = max(
             summary["deadline_misses"]["fsw_overruns"], summary["fsw"].get("overruns", 0)
@@ -449,6 +451,7 @@ def partial_summary(
     summary["fsw"] = _fsw_report(out / "fsw_stats.json", None, out)
     merge_counts(frames, other, "FSW", summary["fsw"].get("sent", {}),
                  summary["fsw"].get("received", {}))
+    zero_unheard(frames, {"BENCH"} | ({"FSW"} if "received" in summary["fsw"] else set()))
     write_summary(out / "summary.json", summary)
     _plot(out, sc)
     return summary

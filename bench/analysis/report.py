@@ -125,6 +125,10 @@ def format_report(rt: RunTiming) -> str:
         + (f" at {load.total.peak_window_start_s:.3f} s" if load.n_windows else "")
         + (f" | {per_node}" if per_node else "")
     )
+    unheard = rt.unheard()
+    if unheard:
+        lines.append("FLAG: sent but never received: " + ", ".join(
+            f"{n} ({rt.sent[n]} frames sent)" for n in unheard))
     flagged = rt.flagged()
     if flagged:
         what = (

@@ -642,6 +642,7 @@ class RunTiming:
         db: Any = None,
         options: TimingOptions | None = None,
         run_dir: Path | None = None,
+        sent: Mapping[str, int] | None = None,
     ) -> None:
         if mode not in MODES:
             raise ConfigError(RUN_SOURCE, "mode", mode, f"one of {', '.join(MODES)}")
@@ -654,6 +655,9 @@ class RunTiming:
         self.db = load_database() if db is None else db
         self.options = options or TimingOptions()
         self.run_dir = run_dir
+        # frames each message's sender says it sent (summary.json): a message sent but never
+        # on the trace is reported with all of them missed, not left out
+        self.sent = {k: int(v) for k, v in (sent or {}).items() if v}
 
     @classmethod
     def load(
@@ -689,6 +693,8 @@ class RunTiming:
             db=db,
             options=options,
             run_dir=d,
+            sent={n: r["sent"] for n, r in summary.get("frames", {}).items()
+                  if isinstance(r, dict) and r.get("sent")},
         )
 
     # -- names -------------------------------------------------------------------------
@@ -741,11 +747,21 @@ class RunTiming:
 
     @cached_property
     def messages(self) -> dict[str, MessageTiming]:
-        """Timing of every message seen in the run, by name, in ID order."""
-        out = {}
-        for can_id, info in self._names.items():
-            out[info[0]] = self._message(can_id, info)
-        return out
+        """Timing of every message seen in the run, or sent in it, by name, in ID order.
+
+        A DBC message its sender sent but that never reached the trace (e.g. dropped by a
+        fault) is included with ``count`` 0 and every sent frame a missed cycle.
+        """
+        names = dict(self._names)
+        for name in self.sent:
+            try:
+                m = self.db.get_message_by_name(name)
+            except KeyError:
+                continue
+            if m.frame_id not in names:
+                names[m.frame_id] = (m.name, m.senders[0] if m.senders else UNKNOWN_NODE,
+                                     m.cycle_time or None)
+        return {info[0]: self._message(can_id, info) for can_id, info in sorted(names.items())}
 
     def message(self, name: str) -> MessageTiming:
         """Timing of one message (a DBC name, or ``0x...`` for an ID outside the DBC).
@@ -780,13 +796,16 @@ class RunTiming:
             )
         finite = np.isfinite(rows.seen_s)
         missed, gaps = missed_cycles(t, rows.counter[finite], cycle_s, o.missed_gap_periods)
+        count = int(np.count_nonzero(all_rows))
+        if count == 0:  # sent, never heard: each one missed
+            missed = self.sent.get(name, 0)
         bound = self.bounds_s.get(name)
         return MessageTiming(
             name=name,
             can_id=can_id,
             sender=sender,
             cycle_time_ms=cycle_ms,
-            count=int(np.count_nonzero(all_rows)),
+            count=count,
             time_source=_time_source(rows),
             period_mean_ms=mean_s * MS_PER_S,
             jitter_std_us=std_s * US_PER_S,
@@ -842,6 +861,10 @@ class RunTiming:
         """Names of the messages whose measured maximum latency exceeds their bound."""
         return [n for n, m in self.messages.items() if m.above_bound]
 
+    def unheard(self) -> list[str]:
+        """Names of the messages their sender sent that never reached the trace."""
+        return [n for n, m in self.messages.items() if m.count == 0 and self.sent.get(n)]
+
     def to_dict(self) -> dict[str, Any]:
         """Everything, JSON-ready (the content of ``timing.json``)."""
         return {
@@ -853,6 +876,7 @@ class RunTiming:
             "chain": self.chain().to_dict(),
             "bus_load": self.bus_load().to_dict(),
             "flags": self.flagged(),
+            "unheard": self.unheard(),
         }
 
 

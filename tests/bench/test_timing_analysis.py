@@ -508,3 +508,18 @@ def test_cli_timing_strict_exit_and_files(
     assert main(["timing", str(bad)]) == EXIT_OK
     assert main(["timing", str(ok), "--window-ms", "0"]) == EXIT_BAD_INPUT
     assert main(["timing"]) == EXIT_BAD_INPUT
+
+
+def test_message_sent_but_never_on_the_trace_is_all_missed(tmp_path: Path) -> None:
+    """THR_CMD_0 sent 50 times (summary.json) but absent from frames.csv: 50 missed, unheard."""
+    d = _write_run(tmp_path / "run", _periodic(IMU_RATE, IMU_PERIOD_S, 100, 100 * US))
+    summary = json.loads((d / "summary.json").read_text())
+    summary["frames"] = {"THR_CMD_0": {"sender": "FSW", "sent": 50, "received": 0},
+                         "IMU_RATE": {"sender": "BENCH", "sent": 100, "received": 100}}
+    (d / "summary.json").write_text(json.dumps(summary))
+    rt = RunTiming.load(d)
+    cmd = rt.messages["THR_CMD_0"]
+    assert (cmd.count, cmd.missed_cycles) == (0, 50)
+    assert rt.unheard() == ["THR_CMD_0"] and rt.messages["IMU_RATE"].missed_cycles == 0
+    assert list(rt.messages) == ["THR_CMD_0", "IMU_RATE"]  # in ID order
+    assert "sent but never received: THR_CMD_0 (50 frames sent)" in format_report(rt)
