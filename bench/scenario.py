@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -637,8 +638,10 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
 def apply_overrides(data: dict[str, Any], overrides: list[str], source: str) -> None:
     """Apply ``KEY=VALUE`` overrides (dotted keys, TOML values) to parsed scenario data in place.
 
-    ``bus.bitrate_bps=125000``, ``flight_sw.modulator.km=10.0``, ``manoeuvre.t_start_s=2``.
-    A value that is not valid TOML is taken as a string. Errors name the override.
+    ``bus.bitrate_bps=125000``, ``flight_sw.modulator.km=10.0``, ``manoeuvre.t_start_s=2``;
+    an element of an array of tables by its index: ``thrusters.list[0].max_thrust_N=5.0``,
+    ``faults[1].t_s=30``. A value that is not valid TOML is taken as a string. Errors name
+    the override.
     """
     for item in overrides:
         key, sep, text = item.partition("=")
@@ -649,13 +652,35 @@ def apply_overrides(data: dict[str, Any], overrides: list[str], source: str) -> 
         except tomllib.TOMLDecodeError:
             value = text
         table = data
-        parts = key.split(".")
-        for part in parts[:-1]:
-            nxt = table.setdefault(part, {})
+        parts = [_override_part(source, key, p) for p in key.split(".")]
+        for name, index in parts[:-1]:
+            nxt = table.setdefault(name, {} if index is None else [])
+            if index is not None:
+                if not isinstance(nxt, list) or not 0 <= index < len(nxt):
+                    size = len(nxt) if isinstance(nxt, list) else 0
+                    raise ConfigError(source, key, item, f"{name!r} to be an array of tables "
+                                      f"with an element {index} (it has {size})")
+                nxt = nxt[index]
             if not isinstance(nxt, dict):
-                raise ConfigError(source, key, item, f"{part!r} to be a table")
+                raise ConfigError(source, key, item, f"{name!r} to be a table")
             table = nxt
-        table[parts[-1]] = value
+        name, index = parts[-1]
+        if index is not None:
+            raise ConfigError(source, key, item, "a key inside the element (e.g. "
+                              f"{name}[{index}].t_s), or the whole array: {name}=[...]")
+        table[name] = value
+
+
+_OVERRIDE_PART = re.compile(r"([A-Za-z0-9_-]+)(?:\[(\d+)\])?")
+
+
+def _override_part(source: str, key: str, part: str) -> tuple[str, int | None]:
+    """``name`` or ``name[i]`` of a dotted override key."""
+    m = _OVERRIDE_PART.fullmatch(part)
+    if m is None:
+        raise ConfigError(source, "--set", key, "a dotted KEY of names, each optionally "
+                          "indexed as name[i]")
+    return m.group(1), None if m.group(2) is None else int(m.group(2))
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:

@@ -46,8 +46,9 @@ class Table:
         self._used.add(key)
         if key not in self._data:
             if default is _MISSING:
-                near = difflib.get_close_matches(key, [str(k) for k in self._data], n=1,
-                                                 cutoff=NEAR_MISS_CUTOFF)
+                # a near miss among the keys nobody has read yet (a read one is not a typo)
+                spare = [str(k) for k in self._data if k not in self._used]
+                near = difflib.get_close_matches(key, spare, n=1, cutoff=NEAR_MISS_CUTOFF)
                 hint = f"; found {near[0]!r}: misspelt?" if near else ""
                 raise self.error(key, None, f"a value (key is required{hint})")
             return default
@@ -146,10 +147,20 @@ class Table:
         return [Table(x, self._source, f"{self._key(key)}[{i}]") for i, x in enumerate(v)]
 
     def done(self) -> None:
-        """Reject keys that were never read (misspelt or unsupported)."""
+        """Reject keys that were never read (misspelt or unsupported).
+
+        The error lists the keys this table takes (those its reader asked for), so a key
+        that belongs to another ``kind`` reads as such, and suggests a near miss.
+        """
         extra = sorted(set(self._data) - self._used)
         if extra:
-            raise self.error(extra[0], self._data[extra[0]], "no such key here (misspelt?)")
+            key = extra[0]
+            near = difflib.get_close_matches(str(key), sorted(self._used), n=1,
+                                             cutoff=NEAR_MISS_CUTOFF)
+            hint = f"did you mean {near[0]!r}? " if near else ""
+            known = ", ".join(sorted(self._used)) or "no keys"
+            raise self.error(key, self._data[key], f"no such key here ({hint}this table "
+                             f"takes: {known})")
 
     @property
     def source(self) -> str:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from bench.scenario import load_scenario, parse_scenario, quat_from_euler_zyx
+from bench.scenario import apply_overrides, load_scenario, parse_scenario, quat_from_euler_zyx
 from dbc import load_database
 from dbc.codec import bitrate_range_bps
 from dbc.errors import ConfigError
@@ -165,3 +165,24 @@ def test_bitrate_range_is_the_dbc_baudrate_definition() -> None:
     for bad in (lo - 1, hi + 1):
         with pytest.raises(ConfigError, match=rf"bus\.bitrate_bps = {bad}"):
             load_scenario(QUICKSTART, [f"bus.bitrate_bps={bad}"])
+
+
+def test_override_addresses_an_element_of_an_array_of_tables() -> None:
+    """--set faults[1].t_s=30 changes that fault only; out-of-range and bare indices are named."""
+    data = {"faults": [{"t_s": 1.0, "kind": "a"}, {"t_s": 2.0, "kind": "b"}]}
+    apply_overrides(data, ["faults[1].t_s=30.0"], "s.toml")
+    assert data["faults"] == [{"t_s": 1.0, "kind": "a"}, {"t_s": 30.0, "kind": "b"}]
+    with pytest.raises(ConfigError, match=r"an element 2 \(it has 2\)"):
+        apply_overrides(data, ["faults[2].t_s=1"], "s.toml")
+    with pytest.raises(ConfigError, match=r"the whole array: faults=\[\.\.\.\]"):
+        apply_overrides(data, ["faults[0]=1"], "s.toml")
+    with pytest.raises(ConfigError, match=r"name\[i\]"):
+        apply_overrides(data, ["faults[x].t_s=1"], "s.toml")
+
+
+def test_key_of_another_kind_lists_what_the_table_takes() -> None:
+    """A key the table does not read: the error lists the keys it does (and a near miss)."""
+    with pytest.raises(ConfigError) as err:
+        load_scenario(QUICKSTART, ["bus.bitrate_bs=125000"])
+    assert "did you mean 'bitrate_bps'?" in str(err.value)
+    assert "this table takes: bitrate_bps," in str(err.value)
