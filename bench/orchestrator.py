@@ -40,6 +40,7 @@ from dbc import load_database
 from dbc.bus import mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.errors import ConfigError, RefusedConfigError, RunError
+from dbc.hilbus import MEMBER_STALL_S
 
 DEFAULT_FSW_CMD = (
     f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
@@ -262,10 +263,12 @@ def _run_bench(
     fsw_drops = int(summary["fsw"].get("bus_overrun_drops", 0) or 0)
     summary["bus_overrun_drops"] = bench_drops + fsw_drops
     if bench_drops + fsw_drops:
-        summary["warnings"].append(
-            f"{bench_drops} bench and {fsw_drops} flight-software frames were dropped for a "
-            "bus member that stopped reading (e.g. a paused can.logger); bench and flight "
-            "software lost nothing unless one of them was that member")
+        fsw_by_pid = {int(k): int(v) for k, v in
+                      (summary["fsw"].get("bus_overrun_drops_by_pid") or {}).items()}
+        summary["warnings"].append(overrun_warning(
+            getattr(bus, "overrun_drops_by_pid", {}), fsw_by_pid, os.getpid(),
+            None if proc is None else proc.pid,
+            float(getattr(bus, "member_stall_s", None) or MEMBER_STALL_S)))
     if any("another node" in w for w in summary["warnings"]):
         summary["passed"] = False
     if error is not None:
@@ -303,6 +306,32 @@ def _plot(out: Path, sc: Scenario) -> None:
     from bench.plots import plot_run
 
     plot_run(out, sc.expectations.settling_band_deg)
+
+
+def overrun_warning(
+    from_bench: dict[int, int], from_fsw: dict[int, int], bench_pid: int,
+    fsw_pid: int | None, stall_s: float,
+) -> str:
+    """The warning for frames the portable bus dropped for members that stopped reading.
+
+    ``from_bench``/``from_fsw``: frames each process dropped, by the receiving member's
+    pid. Naming the member matters: in realtime the one that stalled is often the bench or
+    the flight software itself (a long pause), not a monitor.
+    """
+    def who(pid: int) -> str:
+        if pid == bench_pid:
+            return f"the bench (pid {pid})"
+        if pid == fsw_pid:
+            return f"the flight software (pid {pid})"
+        return f"another member (pid {pid}, e.g. a paused can.logger)"
+
+    parts = [f"{n} from the {src} to {who(pid)}"
+             for src, table in (("bench", from_bench), ("flight software", from_fsw))
+             for pid, n in sorted(table.items())]
+    total = sum(from_bench.values()) + sum(from_fsw.values())
+    return (f"{total} frames were dropped for bus members that did not read for "
+            f"{stall_s * 1000:g} ms ({'; '.join(parts) or 'members unknown'}): only those "
+            "members missed them")
 
 
 def check_bus(spec: str) -> None:

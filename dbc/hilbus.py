@@ -408,6 +408,8 @@ class HilBus(can.BusABC):
         self.malformed_records = 0
         #: frames this member did not deliver to an overrun member (see the module docstring).
         self.overrun_drops = 0
+        #: the same, per overrun member's socket name (``<pid>-<hex>.sock``)
+        self.overrun_drops_to: dict[str, int] = {}
         self.member_stall_s = member_stall_s
         self._name = path.name
         self._path_b = os.fsencode(path)
@@ -532,6 +534,16 @@ class HilBus(can.BusABC):
             + data
         )
 
+    @property
+    def overrun_drops_by_pid(self) -> dict[int, int]:
+        """:attr:`overrun_drops_to` by the overrun member's process id (from its socket name)."""
+        out: dict[int, int] = {}
+        for name, n in self.overrun_drops_to.items():
+            pid = _member_pid(name)
+            if pid is not None:
+                out[pid] = out.get(pid, 0) + n
+        return out
+
     def _send_to(self, peer: _Peer, record: bytes, deadline: float | None) -> None:
         spurious = 0
         stall = self.member_stall_s
@@ -557,6 +569,7 @@ class HilBus(can.BusABC):
             if peer.overrun or _poll_ms(stall_deadline) == 0:
                 peer.overrun = True  # it has not read for member_stall_s: drop, as a CAN
                 self.overrun_drops += 1  # controller's full receive buffer does
+                self.overrun_drops_to[peer.name] = self.overrun_drops_to.get(peer.name, 0) + 1
                 return
             wait_ms = _poll_ms(deadline)
             if wait_ms == 0:

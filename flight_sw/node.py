@@ -475,6 +475,8 @@ class FlightNode:
             "fdir": self._fdir_stats(),
             # portable bus: frames not delivered to a member that stopped reading
             "bus_overrun_drops": getattr(self.bus, "overrun_drops", 0),
+            "bus_overrun_drops_by_pid": {
+                str(k): v for k, v in getattr(self.bus, "overrun_drops_by_pid", {}).items()},
         }
         tmp = self.stats_path.with_suffix(".tmp")
         tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")

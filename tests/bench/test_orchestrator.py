@@ -73,3 +73,13 @@ def test_bench_refusing_its_input_before_the_run_says_why(
     assert str(bad) in str(info.value) and "the bench" in str(info.value)
     summary = json.loads((tmp_path / "run" / "summary.json").read_text(encoding="utf-8"))
     assert summary["refused"] == str(bad) and summary["passed"] is False
+
+
+def test_overrun_warning_names_the_member_that_stalled() -> None:
+    """Drops are attributed per receiving pid: the bench, the flight software or another."""
+    w = orchestrator.overrun_warning({77: 3}, {10: 6, 77: 1}, bench_pid=10, fsw_pid=20,
+                                     stall_s=0.01)
+    assert w.startswith("10 frames were dropped for bus members that did not read for 10 ms")
+    assert "6 from the flight software to the bench (pid 10)" in w
+    assert "3 from the bench to another member (pid 77" in w
+    assert "1 from the flight software to another member (pid 77" in w
