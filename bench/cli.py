@@ -91,10 +91,12 @@ def _default_out(name: str) -> Path:
 
 
 def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
-    from bench.orchestrator import DEFAULT_FSW_CMD, RunOptions, run_scenario
+    from bench.orchestrator import DEFAULT_FSW_CMD, RunOptions, run_scenario, scenario_warnings
     from bench.scenario import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
+    for w in scenario_warnings(sc):  # said before the run too, not only in its summary
+        print(f"thruster-hil: warning: {w}", file=sys.stderr)
     bus = args.bus or default_bus_spec()
     BusSpec.parse(bus)
     opts = RunOptions(

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from bench.analysis.reception import RX_LOG_FILE
+from bench.authority import WRENCH_CONTROLLERS, authority_warnings
 from bench.metrics import pointing_metrics
 from bench.node import BenchNode, frame_table, merge_counts, zero_unheard
 from bench.recorder import write_summary
@@ -256,7 +257,8 @@ def _run_bench(
         summary["deadline_misses"]["total"] = sum(
             v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns")
         )
-    summary["warnings"] = bus_warnings(summary["frames"]) + duration_warnings(sc, opts.duration_s)
+    summary["warnings"] = (bus_warnings(summary["frames"]) + duration_warnings(sc, opts.duration_s)
+                           + scenario_warnings(sc))
     # hilbus: frames the bench and the flight software could not deliver to a member that
     # stopped reading (each process counts its own)
     bench_drops = getattr(bus, "overrun_drops", 0)
@@ -341,6 +343,15 @@ def check_bus(spec: str) -> None:
     bench fail where only its exit code is seen.
     """
     open_bus(spec).shutdown()
+
+
+def scenario_warnings(sc: Scenario) -> list[str]:
+    """What the scenario's vehicle cannot do (:mod:`bench.authority`): axes its thrusters
+    cannot push about or along, for the degrees of freedom its flight software controls."""
+    controller = (sc.flight_sw.get("controller") or {}).get("kind")
+    needs_force = controller in WRENCH_CONTROLLERS or "translation" in sc.flight_sw
+    return authority_warnings([t.r_thr_B_m for t in sc.thrusters],
+                              [t.d_thr_B for t in sc.thrusters], needs_force)
 
 
 def duration_warnings(sc: Scenario, duration_s: float) -> list[str]:
