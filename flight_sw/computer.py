@@ -65,6 +65,9 @@ WRENCH_DIM = 6
 ZERO3 = (0.0, 0.0, 0.0)
 MAX_THR_STATUS = 16  # THR_STATUS carries thrusters 0..15
 DEFAULT_NAV_TIMEOUT_NS = 300_000_000  # 3 NAV_POS periods of 100 ms
+# realtime: the cycle 2 ms after the bench's control instant (its samples of that instant
+# have arrived; lockstep models the same answer 1 ms after SYNC)
+DEFAULT_CYCLE_PHASE_NS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -123,6 +126,8 @@ class FlightComputer:
     guidance: AttitudeGuidance | None = None  # a moving reference (else the Timeline's step)
     pose: PoseController | None = None  # a coupled 6-DoF law (replaces both controllers)
     inertia_id: InertiaIdentifier | None = None
+    # realtime: each cycle starts this long after one of the bench's control instants
+    cycle_phase_ns: int = DEFAULT_CYCLE_PHASE_NS
     mode: Mode = Mode.BOOT
     safe_latched: bool = False
     imu_counter: int = 0

@@ -41,7 +41,12 @@ from flight_sw.allocation.qp_osqp import BoundedQpAllocator, BoundedQpParams
 from flight_sw.allocation.robust_lft import RobustLftAllocator, RobustLftParams
 from flight_sw.allocation.robust_polyhedral import RobustPolyhedralAllocator
 from flight_sw.allocation.robust_polytopic import RobustParams, RobustPolytopicAllocator
-from flight_sw.computer import DEFAULT_NAV_TIMEOUT_NS, FlightComputer, Timeline
+from flight_sw.computer import (
+    DEFAULT_CYCLE_PHASE_NS,
+    DEFAULT_NAV_TIMEOUT_NS,
+    FlightComputer,
+    Timeline,
+)
 from flight_sw.control.base import AttitudeController, PoseController, TranslationController
 from flight_sw.control.cascade_lqr import CascadeLqr, CascadeLqrDesign, CascadeLqrParams
 from flight_sw.control.mrp_direct_parametric import MrpDirectParametric, MrpDirectParametricParams
@@ -643,6 +648,8 @@ def build_computer(
         else None
     )
     thruster_fdir, precompute = _thruster_fdir(fsw, vehicle)
+    phase_s = fsw.number("realtime_cycle_phase_s", DEFAULT_CYCLE_PHASE_NS / NS_PER_S, lo=0.0,
+                         hi=(control_period_ns - 1) / NS_PER_S)
     if fsw.has("sensor_fdir"):
         monitor = _strategy(fsw, "sensor_fdir", SENSOR_FDIR, vehicle)
     else:
@@ -683,6 +690,7 @@ def build_computer(
         guidance=guidance,
         inertia_id=inertia_id,
         pose=pose,
+        cycle_phase_ns=round(phase_s * NS_PER_S),
     )
 
 

@@ -80,6 +80,12 @@ ALLOC_RESIDUAL_MAX_NM = 12.75  # FSW_STATUS.AllocResidual range
 ALLOC_RESIDUAL_MAX_N = 12.75  # FSW_STATUS.AllocForceResidual range
 
 
+def _next_phase_ns(now_ns: int, base_ns: int, period_ns: int, phase_ns: int) -> int:
+    """The first ``base + k·period + phase`` (k integer) after ``now_ns``."""
+    k = (now_ns - base_ns - phase_ns) // period_ns + 1
+    return base_ns + k * period_ns + phase_ns
+
+
 def _spread(values: list[float]) -> dict[str, float | None]:
     """p50, p99 and max of ``values`` (full precision; the bus carries 0.05 steps)."""
     if not values:
@@ -318,17 +324,22 @@ class FlightNode:
             self._on_bench_time(round(float(s["SimTime"]) * MS_PER_S) * NS_PER_MS, t_ns)
 
     def _on_bench_time(self, bench_ns: int, t_ns: int) -> None:
-        """BENCH_STATUS SimTime: a step back is a bench restart; realtime aligns on the first."""
+        """BENCH_STATUS SimTime: a step back is a bench restart; realtime aligns on it (the
+        first one, then any that shows the bench's time 0 earlier)."""
         last = self._bench_time_ns
         self._bench_time_ns = bench_ns
         if last is not None and bench_ns < last:
             now = self.clock.now_ns() if self._realtime else bench_ns
             self.bench_restarted(now, bench_ns)
             self._bench_time_ns = bench_ns
-        elif self._realtime and not self._time_aligned:
-            self.fc.timeline.time_base_ns = self.clock.now_ns() - bench_ns
-            if self.fc.thruster_fdir is not None:
-                self.fc.thruster_fdir.time_base_ns = self.fc.timeline.time_base_ns
+        elif self._realtime:
+            # our time of the bench's time 0: the earliest estimate so far (each arrives
+            # late by its transport and our own reading delay, never early; same clock)
+            base = self.clock.now_ns() - bench_ns
+            if not self._time_aligned or base < self.fc.timeline.time_base_ns:
+                self.fc.timeline.time_base_ns = base
+                if self.fc.thruster_fdir is not None:
+                    self.fc.thruster_fdir.time_base_ns = base
             self._time_aligned = True
 
     def bench_restarted(self, t_ns: int, bench_ns: int) -> None:
@@ -385,16 +396,29 @@ class FlightNode:
         self.write_stats()
 
     def run_realtime(self) -> None:
-        """Cycle on this process's own timer until stopped."""
+        """Cycle on this process's own timer until stopped.
+
+        The timer free-runs until the bench's time is known (its first BENCH_STATUS), then
+        is put in phase with it: each cycle starts ``cycle_phase_ns`` after one of the
+        bench's control instants (multiples of the period in its time), so the sensor
+        samples of that instant have arrived. A free-running timer would sit at a random
+        phase, often just before the samples: a run-to-run spread of up to a period in
+        the sensor-to-command latency.
+        """
         clock = self.clock
         self._realtime = True
         self._heartbeat()
         period = self.period_ns
         next_ns = clock.now_ns() + period
         cycle = 0
+        phased_base: int | None = None
         self.fc.watchdog.start(clock.now_ns())
         while not self._stop:
             now = clock.now_ns()
+            base = self.fc.timeline.time_base_ns
+            if self._time_aligned and base != phased_base:
+                phased_base = base
+                next_ns = _next_phase_ns(now, base, period, self.fc.cycle_phase_ns)
             if now < next_ns:
                 msg = self.bus.recv(timeout=(next_ns - now) / 1e9)
                 if msg is not None:
