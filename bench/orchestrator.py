@@ -259,6 +259,11 @@ def _run_bench(
         )
     summary["warnings"] = (bus_warnings(summary["frames"]) + duration_warnings(sc, opts.duration_s)
                            + scenario_warnings(sc))
+    if error is None and not (summary.get("valve_openings") or {}).get("total"):
+        summary["warnings"].append(
+            "no valve opened in the whole run: if the vehicle was to move, check the thrust "
+            "levels against its inertia and the modulator's thresholds (an on-time too short "
+            "for min_on_s or a Schmitt trigger's u_on is never commanded)")
     # hilbus: frames the bench and the flight software could not deliver to a member that
     # stopped reading (each process counts its own)
     bench_drops = getattr(bus, "overrun_drops", 0)

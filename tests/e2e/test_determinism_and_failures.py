@@ -153,3 +153,11 @@ def test_flight_software_restart_is_detected_and_the_run_continues(
     # after the restart every cycle is answered again
     cycles = round(float(SHORT_S) / CONTROL_PERIOD_S)
     assert s["frames"]["THR_CMD_0"]["received"] >= cycles - MAX_RESTART_STALLS
+
+
+def test_run_in_which_no_valve_opens_is_warned(tmp_path: Path, runtime_dir: Path) -> None:
+    """10 kN thrusters on the quickstart: the modulators never fire, and the run says so."""
+    r = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--duration", "2",
+                 "--set", "thrusters.max_thrust_N=10000"], tmp_path / "run", runtime_dir)
+    assert r.summary["valve_openings"]["total"] == 0
+    assert any(w.startswith("no valve opened") for w in r.summary["warnings"])
