@@ -6,6 +6,7 @@ import contextlib
 import json
 import os
 import selectors
+import signal
 import subprocess
 import sys
 import uuid
@@ -77,6 +78,11 @@ def unique_bus() -> str:
 PROGRESS_DEADLINE_S = 120.0
 
 
+def _default_sigint() -> None:
+    """In the child before exec: SIGINT back to its default (Python then raises on it)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @contextlib.contextmanager
 def running(
     args: list[str], out: Path, runtime_dir: Path, min_percent: float = 0.0,
@@ -86,7 +92,9 @@ def running(
     ``min_percent``; on exit it is waited for (and killed if a test failed meanwhile).
 
     ``own_group``: in a process group of its own (its pid), as a terminal's foreground job,
-    so that a signal can go to all its processes at once (``os.killpg``)."""
+    so that a signal can go to all its processes at once (``os.killpg``), and with SIGINT
+    at its default disposition as a terminal gives it (a background job of a
+    non-interactive shell, such as a CI runner's, inherits it ignored)."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
     p = subprocess.Popen(
         [sys.executable, "-m", "bench.cli", *args, "--out", str(out)],
@@ -96,6 +104,7 @@ def running(
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=own_group,
+        preexec_fn=_default_sigint if own_group else None,
     )
     try:
         assert p.stderr is not None
