@@ -39,7 +39,6 @@ from __future__ import annotations
 import numpy as np
 
 from flight_sw import quaternion as quat
-from flight_sw.quaternion import cross as cross3
 
 HALF = 0.5
 
@@ -55,12 +54,33 @@ def identity() -> np.ndarray:
 
 
 def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Dual-quaternion product ``â ∘ b̂ = a ⊗ b + ϵ (a ⊗ b′ + a′ ⊗ b)`` (eq. 4)."""
-    a = np.asarray(a, dtype=float)
-    b = np.asarray(b, dtype=float)
-    real = quat.multiply(a[:4], b[:4])
-    dual = quat.multiply(a[:4], b[4:]) + quat.multiply(a[4:], b[:4])
-    return np.concatenate((real, dual))
+    """Dual-quaternion product ``â ∘ b̂ = a ⊗ b + ϵ (a ⊗ b′ + a′ ⊗ b)`` (eq. 4).
+
+    Written out on floats (the hot path of the 6-DoF law: one array per product instead
+    of three Hamilton products and their sums); each component is evaluated in the order
+    of :func:`flight_sw.quaternion.multiply`, so the result is bit-identical to building it
+    from three of those (``tests/flight_sw/test_dual_quaternion.py`` checks it).
+    """
+    a0, a1, a2, a3, c0, c1, c2, c3 = np.asarray(a, dtype=float).tolist()
+    b0, b1, b2, b3, e0, e1, e2, e3 = np.asarray(b, dtype=float).tolist()
+    return np.array(_mul(a0, a1, a2, a3, c0, c1, c2, c3, b0, b1, b2, b3, e0, e1, e2, e3))
+
+
+def _mul(
+    a0: float, a1: float, a2: float, a3: float, c0: float, c1: float, c2: float, c3: float,
+    b0: float, b1: float, b2: float, b3: float, e0: float, e1: float, e2: float, e3: float,
+) -> tuple[float, float, float, float, float, float, float, float]:
+    """``(a + ϵ c) ∘ (b + ϵ e)`` on floats (see :func:`multiply`)."""
+    return (
+        a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+        a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+        a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+        a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+        (a0 * e0 - a1 * e1 - a2 * e2 - a3 * e3) + (c0 * b0 - c1 * b1 - c2 * b2 - c3 * b3),
+        (a0 * e1 + a1 * e0 + a2 * e3 - a3 * e2) + (c0 * b1 + c1 * b0 + c2 * b3 - c3 * b2),
+        (a0 * e2 - a1 * e3 + a2 * e0 + a3 * e1) + (c0 * b2 - c1 * b3 + c2 * b0 + c3 * b1),
+        (a0 * e3 + a1 * e2 - a2 * e1 + a3 * e0) + (c0 * b3 + c1 * b2 - c2 * b1 + c3 * b0),
+    )
 
 
 def conjugate(a: np.ndarray) -> np.ndarray:
@@ -111,11 +131,18 @@ def scalar_part(dq: np.ndarray) -> tuple[float, float]:
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Dual cross product ``â × b̂ = a × b + ϵ (a × b′ + a′ × b)`` of dual vectors (eq. 2)."""
-    a = np.asarray(a, dtype=float)
-    b = np.asarray(b, dtype=float)
-    real = cross3(a[:3], b[:3])
-    dual = cross3(a[:3], b[3:]) + cross3(a[3:], b[:3])
-    return np.concatenate((real, dual))
+    a0, a1, a2, c0, c1, c2 = np.asarray(a, dtype=float).tolist()
+    b0, b1, b2, e0, e1, e2 = np.asarray(b, dtype=float).tolist()
+    return np.array(
+        (
+            a1 * b2 - a2 * b1,
+            a2 * b0 - a0 * b2,
+            a0 * b1 - a1 * b0,
+            (a1 * e2 - a2 * e1) + (c1 * b2 - c2 * b1),
+            (a2 * e0 - a0 * e2) + (c2 * b0 - c0 * b2),
+            (a0 * e1 - a1 * e0) + (c0 * b1 - c1 * b0),
+        )
+    )
 
 
 def transform_twist(dq: np.ndarray, twist: np.ndarray) -> np.ndarray:
@@ -125,17 +152,20 @@ def transform_twist(dq: np.ndarray, twist: np.ndarray) -> np.ndarray:
     (D's twist at D's origin, D axes), the result is ``C_BD ω_D + ϵ (C_BD v_D + (C_BD ω_D) ×
     p_B)``: the same motion, at B's origin and in B axes.
     """
-    w = np.asarray(twist, dtype=float)
-    wq = np.concatenate((_pure(w[:3]), _pure(w[3:])))
-    out = multiply(multiply(conjugate(dq), wq), dq)
-    return np.concatenate((out[1:4], out[5:8]))
+    w1, w2, w3, v1, v2, v3 = np.asarray(twist, dtype=float).tolist()
+    a0, a1, a2, a3, c0, c1, c2, c3 = np.asarray(dq, dtype=float).tolist()
+    # (q̂* ∘ ŵ) ∘ q̂, as two products of multiply
+    p = _mul(a0, -a1, -a2, -a3, c0, -c1, -c2, -c3, 0.0, w1, w2, w3, 0.0, v1, v2, v3)
+    out = _mul(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], a0, a1, a2, a3, c0, c1, c2, c3)
+    return np.array((out[1], out[2], out[3], out[5], out[6], out[7]))
 
 
 def derivative(dq: np.ndarray, twist: np.ndarray) -> np.ndarray:
     """Kinematics ``q̂̇ = ½ q̂ ∘ (0, ω̂)`` (eq. 7) with the body twist ``ω̂`` (6,)."""
-    w = np.asarray(twist, dtype=float)
-    wq = np.concatenate((_pure(w[:3]), _pure(w[3:])))
-    return HALF * multiply(dq, wq)
+    w1, w2, w3, v1, v2, v3 = np.asarray(twist, dtype=float).tolist()
+    a0, a1, a2, a3, c0, c1, c2, c3 = np.asarray(dq, dtype=float).tolist()
+    out = _mul(a0, a1, a2, a3, c0, c1, c2, c3, 0.0, w1, w2, w3, 0.0, v1, v2, v3)
+    return HALF * np.array(out)
 
 
 def kinematics_matrix(dq: np.ndarray) -> np.ndarray:
@@ -144,15 +174,17 @@ def kinematics_matrix(dq: np.ndarray) -> np.ndarray:
     Block form ``[[Θ, 0], [Θ′, Θ]]`` with ``Θ = ½ (q0 I + [vec(q)×])`` and
     ``Θ′ = ½ (q′0 I + [vec(q′)×])``. Its real block is singular only at ``q0 = 0`` (180°).
     """
-    dq = np.asarray(dq, dtype=float)
-    eye = np.eye(3)
-    theta = HALF * (dq[0] * eye + quat.skew(dq[1:4]))
-    theta_d = HALF * (dq[4] * eye + quat.skew(dq[5:8]))
-    out = np.zeros((6, 6))
-    out[:3, :3] = theta
-    out[3:, 3:] = theta
-    out[3:, :3] = theta_d
-    return out
+    q0, q1, q2, q3, d0, d1, d2, d3 = (HALF * np.asarray(dq, dtype=float)).tolist()
+    return np.array(
+        (
+            (q0, -q3, q2, 0.0, 0.0, 0.0),
+            (q3, q0, -q1, 0.0, 0.0, 0.0),
+            (-q2, q1, q0, 0.0, 0.0, 0.0),
+            (d0, -d3, d2, q0, -q3, q2),
+            (d3, d0, -d1, q3, q0, -q1),
+            (-d2, d1, d0, -q2, q1, q0),
+        )
+    )
 
 
 def kinematics_matrix_rate(dq: np.ndarray, twist: np.ndarray) -> np.ndarray:
