@@ -35,6 +35,7 @@ from bench.analysis.reception import RX_LOG_FILE
 from bench.authority import WRENCH_CONTROLLERS, authority_warnings
 from bench.metrics import pointing_metrics
 from bench.node import BenchNode, frame_table, merge_counts, zero_unheard
+from bench.plausibility import mass_warnings
 from bench.recorder import write_summary
 from bench.scenario import Scenario
 from dbc import load_database
@@ -352,11 +353,17 @@ def check_bus(spec: str) -> None:
 
 def scenario_warnings(sc: Scenario) -> list[str]:
     """What the scenario's vehicle cannot do (:mod:`bench.authority`): axes its thrusters
-    cannot push about or along, for the degrees of freedom its flight software controls."""
+    cannot push about or along, for the degrees of freedom its flight software controls;
+    and mass properties that look like a unit slip (:mod:`bench.plausibility`)."""
     controller = (sc.flight_sw.get("controller") or {}).get("kind")
     needs_force = controller in WRENCH_CONTROLLERS or "translation" in sc.flight_sw
-    return authority_warnings([t.r_thr_B_m for t in sc.thrusters],
-                              [t.d_thr_B for t in sc.thrusters], needs_force)
+    r_thr = [t.r_thr_B_m for t in sc.thrusters]
+    out = authority_warnings(r_thr, [t.d_thr_B for t in sc.thrusters], needs_force)
+    out += mass_warnings("[vehicle]", sc.actual.mass_kg, sc.actual.inertia_B_kgm2, r_thr)
+    if sc.nominal != sc.actual:
+        out += mass_warnings("[vehicle.nominal]", sc.nominal.mass_kg,
+                             sc.nominal.inertia_B_kgm2, r_thr)
+    return out
 
 
 def duration_warnings(sc: Scenario, duration_s: float) -> list[str]:

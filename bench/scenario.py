@@ -40,6 +40,8 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 DEG_RAD = math.pi / 180.0
+# A target Euler angle beyond a full turn is no attitude anyone writes: a unit slip.
+EULER_LIMIT_DEG = 360.0
 SQRT_HOUR_S = 60.0  # sqrt(3600 s)
 UNIT_NORM_TOL = 1e-6
 MODES = ("lockstep", "realtime")
@@ -557,7 +559,8 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         if mt.has("target_q_BN"):
             q_target = _quat(mt, "target_q_BN")
         else:
-            yaw, pitch, roll = (x * DEG_RAD for x in mt.vector("target_euler_zyx_deg", 3))
+            euler = mt.vector("target_euler_zyx_deg", 3, lo=-EULER_LIMIT_DEG, hi=EULER_LIMIT_DEG)
+            yaw, pitch, roll = (x * DEG_RAD for x in euler)
             q_target = quat_from_euler_zyx(yaw, pitch, roll)
         ref = ReferenceParams(kind, q_target, t_start_s=t_start, source=f"{source}: manoeuvre")
     r_target = mt.vector3("r_target_N_m") if mt.has("r_target_N_m") else None

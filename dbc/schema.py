@@ -91,8 +91,16 @@ class Table:
             raise self.error(key, v, "one of " + ", ".join(repr(c) for c in choices))
         return v
 
-    def vector(self, key: str, n: int, default: Any = _MISSING) -> tuple[float, ...]:
-        """A list of ``n`` finite numbers."""
+    def vector(
+        self,
+        key: str,
+        n: int,
+        default: Any = _MISSING,
+        *,
+        lo: float | None = None,
+        hi: float | None = None,
+    ) -> tuple[float, ...]:
+        """A list of ``n`` finite numbers, each in [lo, hi] when those are given."""
         v = self.raw(key, default)
         if (
             not isinstance(v, list)
@@ -103,6 +111,8 @@ class Table:
             )
         ):
             raise self.error(key, v, f"a list of {n} finite numbers")
+        if (lo is not None and min(v) < lo) or (hi is not None and max(v) > hi):
+            raise self.error(key, v, f"a list of {n} numbers in [{lo}, {hi}]")
         return tuple(float(x) for x in v)
 
     def vector3(self, key: str, default: Any = _MISSING) -> tuple[float, float, float]:

@@ -78,6 +78,12 @@ def test_euler_target_known_answer() -> None:
         ("bus", "bitrate_bps", 2_000_000, "bus.bitrate_bps"),
         ("manoeuvre", "t_start_s", 1e9, "manoeuvre.t_start_s"),
         ("thrusters", "max_thrust", 15.0, "thrusters.max_thrust"),  # misspelt key
+        (  # beyond a full turn: a unit slip (e.g. an angle in arcminutes)
+            "manoeuvre",
+            "target_euler_zyx_deg",
+            [2000.0, 0.0, 0.0],
+            "manoeuvre.target_euler_zyx_deg",
+        ),
     ],
 )
 def test_bad_field_names_file_key_and_value(
