@@ -200,7 +200,7 @@ class BenchNode:
         self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
         self.arbiter = BusArbiter(sc.bus.bitrate_bps)
         self._intermission_ns = wire_time_ns(INTERMISSION_BITS, sc.bus.bitrate_bps)
-        self.trace = TraceRecorder(run_dir)
+        self.trace = TraceRecorder(run_dir, Clock().wall0_s)
         self.telemetry = TelemetryWriter(run_dir / "telemetry.csv", self._columns())
         self.chains = TelemetryWriter(run_dir / "chains.csv", CHAIN_COLUMNS)
         self.open_delay_ns = round(sc.valve.open_delay_s * NS_PER_S)

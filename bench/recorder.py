@@ -15,7 +15,7 @@
   newest IMU_RATE used (its transmit time), last THR_CMD reception, first valve opening.
 * ``events.jsonl`` — one JSON object per event (faults, watchdog, stalls), flushed per line.
 
-No clock is read here: every timestamp is passed in.
+No clock is read here: every timestamp is passed in (the trace's start date too).
 """
 
 from __future__ import annotations
@@ -23,12 +23,14 @@ from __future__ import annotations
 import csv
 import json
 import math
+from datetime import datetime
 from pathlib import Path
 from typing import IO, Any
 
 import can
 
 NS_PER_S = 1e9
+US_PER_MS = 1000
 NAN = float("nan")
 # events also written into trace.asc (python-can's ASC reader skips such lines)
 TRACE_EVENTS = frozenset({"fault_injected", "fault_cleared", "valve_watchdog",
@@ -45,9 +47,19 @@ NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at
 class TraceRecorder:
     """CAN trace in Vector ASC format, plus an events log."""
 
-    def __init__(self, run_dir: Path) -> None:
+    def __init__(self, run_dir: Path, start_wall_s: float) -> None:
+        """``start_wall_s``: wall-clock time of the run's start (``time.time()`` seconds)."""
         self.path = run_dir / "trace.asc"
-        self._writer = can.ASCWriter(str(self.path), channel=1)
+        self._writer = w = can.ASCWriter(str(self.path), channel=1)
+        # The trigger block is dated when the run started (metadata, as the file's "date"
+        # line); frame times stay run time, relative to it. Left to python-can, it is dated
+        # from the first frame's timestamp: 1 Jan 1970 for a run that starts at t = 0.
+        start = datetime.fromtimestamp(start_wall_s)
+        date = start.strftime(w.FORMAT_DATE.format(start.microsecond // US_PER_MS))
+        w.file.write(f"Begin Triggerblock {date}\n")
+        w.header_written = True
+        w.started = w.last_timestamp = 0.0
+        w.log_event("Start of measurement")
         self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
         self._frames = TelemetryWriter(run_dir / "frames.csv", FRAME_COLUMNS)
         self.frames_written = 0
