@@ -124,3 +124,21 @@ def test_short_way_keeps_the_pose(sign: float, rng: np.random.Generator) -> None
     q_s, r_s = dq.to_pose(s)
     np.testing.assert_allclose(quat.to_dcm(q_s), quat.to_dcm(q), atol=TOL)
     np.testing.assert_allclose(r_s, r, atol=1e-10)
+
+
+def test_product_is_bit_identical_to_three_hamilton_products(rng: np.random.Generator) -> None:
+    """â ∘ b̂ written out on floats equals a ⊗ b + ϵ (a ⊗ b′ + a′ ⊗ b) from quat.multiply exactly."""
+    for _ in range(N_RANDOM):
+        a, b = rng.normal(size=8), rng.normal(size=8)
+        real = quat.multiply(a[:4], b[:4])
+        dual = quat.multiply(a[:4], b[4:]) + quat.multiply(a[4:], b[:4])
+        assert np.array_equal(dq.multiply(a, b), np.concatenate((real, dual)))
+
+
+def test_kinematics_matrix_is_the_block_form(rng: np.random.Generator) -> None:
+    """Θ̂ = [[Θ, 0], [Θ′, Θ]] with Θ = ½ (q0 I + [vec(q)×]), Θ′ likewise from the dual part."""
+    q = rng.normal(size=8)
+    theta = 0.5 * (q[0] * np.eye(3) + quat.skew(q[1:4]))
+    theta_d = 0.5 * (q[4] * np.eye(3) + quat.skew(q[5:8]))
+    expected = np.block([[theta, np.zeros((3, 3))], [theta_d, theta]])
+    assert np.array_equal(dq.kinematics_matrix(q), expected)

@@ -14,6 +14,7 @@ from flight_sw.control.nftsm_dq import (
     NftsmDq,
     NftsmDqParams,
     auxiliary_surface,
+    sig,
 )
 from flight_sw.control.tsm_dq import TsmDq, TsmDqParams
 
@@ -30,6 +31,9 @@ TINY_ERRORS = (1e-3, 1e-6, 1e-9, 1e-12)
 ZERO_WRENCH_TOL = 1e-9
 ZERO3 = np.zeros(3)
 NS_PER_S = 1_000_000_000
+SEED_AUX = 11
+N_AUX_CASES = 200
+AUX_RTOL = 1e-15  # the same operations in the same order: round-off at most
 
 
 def _disturbance(t_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -198,3 +202,34 @@ def test_params_reject_bad_values(key: str, value: object) -> None:
     """NftsmDqParams raises ConfigError naming the bad key."""
     with pytest.raises(ConfigError, match=key):
         NftsmDqParams(**{key: value})  # type: ignore[arg-type]
+
+
+def _auxiliary_surface_vectorised(
+    xi: np.ndarray, xi_dot: np.ndarray, alpha1: np.ndarray, alpha2: np.ndarray, p1: float,
+    delta: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Eqs. (14)-(16), (18)-(19) as whole-array operations: the oracle of the float version."""
+    abs_xi = np.abs(xi)
+    s_bar = xi_dot + alpha1 * xi + alpha2 * sig(xi, p1)
+    power = (s_bar == 0.0) | (abs_xi >= delta)
+    r1 = (2.0 - p1) * delta ** (p1 - 1.0)
+    r2 = (p1 - 1.0) * delta ** (p1 - 2.0)
+    s_a = np.where(power, sig(xi, p1), r1 * xi + r2 * sig(xi, 2.0))
+    safe = np.where(abs_xi > 0.0, abs_xi, 1.0)
+    w_power = np.where(abs_xi > 0.0, p1 * safe ** (p1 - 1.0) * xi_dot, 0.0)
+    return s_a, np.where(power, w_power, (r1 + 2.0 * r2 * abs_xi) * xi_dot)
+
+
+def test_auxiliary_surface_matches_the_vectorised_equations() -> None:
+    """Both branches, zeros and signs: the per-component version equals the array form."""
+    rng = np.random.default_rng(SEED_AUX)
+    delta = np.array([0.05] * 3 + [0.001] * 3)
+    for _ in range(N_AUX_CASES):
+        xi = rng.normal(size=6) * rng.choice([1e-4, 1e-2, 1.0], size=6)
+        xi[rng.integers(6)] = 0.0
+        xi_dot = rng.normal(size=6)
+        a1, a2 = rng.uniform(0.01, 1.0, size=6), rng.uniform(0.01, 1.0, size=6)
+        got = auxiliary_surface(xi, xi_dot, a1, a2, 0.6, delta)
+        want = _auxiliary_surface_vectorised(xi, xi_dot, a1, a2, 0.6, delta)
+        np.testing.assert_allclose(got[0], want[0], rtol=AUX_RTOL, atol=0.0)
+        np.testing.assert_allclose(got[1], want[1], rtol=AUX_RTOL, atol=0.0)
