@@ -1,7 +1,7 @@
 """Plausibility of a vehicle's mass properties: signs of a unit slip, said before a run.
 
-What it does: compares the radius of gyration ``k = √(J_max / m)`` [m] (the largest
-principal-axis moment of the inertia matrix's diagonal, about the centre of mass) with the
+What it does: compares the radius of gyration ``k = √(J_max / m)`` [m] (``J_max`` the largest
+diagonal element of the inertia matrix about the centre of mass) with the
 farthest thruster's distance from the body origin ``|r_thr_B|`` [m]. Thrusters sit on the
 structure, so the mass is distributed over a body of about that size: for every vehicle in
 ``scenarios/`` the ratio ``k / |r_thr|`` lies in 0.2–1.7, and for a rod of length ``2 L``

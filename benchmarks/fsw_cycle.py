@@ -18,8 +18,9 @@ much, so the hot figure is the best case of a cycle that runs back to back with 
 never met in a run (on this machine; caches and branch predictors are the likely cause).
 ``idle``: the first :data:`IDLE_CYCLES` cycles replayed with :data:`IDLE_S` of sleep before
 each, the rest of the period, as the flight software spends it blocked on the bus in a run:
-this alone reproduces the in-run figure (a CPU that idled for most of a period runs the
-next cycle ~2x slower on this virtual machine; on a flight computer one would not idle the
+this alone brings the figure to the in-run one (p50 within 40 % of it in every case on
+2026-12-02: a CPU that idled for most of a period runs the next cycle 1.5-3.6x slower on
+this virtual machine; on a flight computer one would not idle the
 core, or would pin and isolate it).
 ``wall_clock`` reads here are the benchmark's, not the flight software's.
 
