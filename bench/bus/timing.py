@@ -636,10 +636,10 @@ class BusArbiter:
                     continue
                 ready = contenders
             win = min(ready, key=_PRIORITY)
-            for f in ready:
-                if f is not win:
-                    heapq.heappush(pending, f)
             seq = win[2]
+            for f in ready:
+                if f[2] != seq:  # by sequence number, not identity (compiled tuples are values)
+                    heapq.heappush(pending, f)
             retry = self._retries.get(seq)
             if retry is not None and retry.left > 0:  # this attempt fails
                 retry.left -= 1

@@ -58,6 +58,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from dbc.errors import ConfigError
 
@@ -93,6 +94,7 @@ QUAT_NORM_TOL = 1e-6
 MATRIX_DIM = 3
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class MassProperties:
     """Mass [kg] and inertia tensor about the centre of mass in body axes [kg·m²].

@@ -37,6 +37,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from bench.dynamics.rigid_body import Vec3
 from bench.sensors.gyro import (
@@ -51,6 +52,7 @@ from bench.sensors.gyro import (
 from dbc.errors import ConfigError
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class AccelerometerParams:
     """Accelerometer error model; defaults are ideal and unsaturated at 200 Hz.
@@ -75,7 +77,8 @@ class AccelerometerParams:
     def __post_init__(self) -> None:
         src = self.source
         put = object.__setattr__
-        put(self, "bias_m_s2", check_vec3(self.bias_m_s2, src, "bias_m_s2"))
+        given = getattr(self, "bias_m_s2")  # noqa: B009 - uncast (see setup.py)
+        put(self, "bias_m_s2", check_vec3(given, src, "bias_m_s2"))
         for key in ("vrw_m_s_sqrt_s", "bias_rw_m_s2_sqrt_s", "lsb_m_s2"):
             put(self, key, check_number(getattr(self, key), src, key, positive=False))
         put(self, "period_s", check_number(self.period_s, src, "period_s", positive=True))

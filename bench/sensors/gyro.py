@@ -58,6 +58,7 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from bench.dynamics.rigid_body import Vec3
 from dbc.errors import ConfigError, ThrusterHilError
@@ -185,6 +186,7 @@ def check_fault_kind(
             raise ConfigError(source, key, None, f"a value (required by {kind!r})")
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class GyroParams:
     """Gyro error model; defaults are an ideal, unsaturated gyro sampled at 200 Hz.
@@ -209,7 +211,8 @@ class GyroParams:
     def __post_init__(self) -> None:
         src = self.source
         put = object.__setattr__
-        put(self, "bias_rad_s", check_vec3(self.bias_rad_s, src, "bias_rad_s"))
+        given = getattr(self, "bias_rad_s")  # noqa: B009 - uncast (see setup.py)
+        put(self, "bias_rad_s", check_vec3(given, src, "bias_rad_s"))
         for key in ("bias_rw_rad_s_sqrt_s", "arw_rad_sqrt_s", "lsb_rad_s"):
             put(self, key, check_number(getattr(self, key), src, key, positive=False))
         put(self, "period_s", check_number(self.period_s, src, "period_s", positive=True))

@@ -50,6 +50,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from bench.dynamics.rigid_body import QUAT_IDENTITY, Quat, Vec3, quat_multiply
 from bench.sensors.gyro import (
@@ -91,6 +92,7 @@ def rotation_vector_quat(theta: Vec3) -> Quat:
     return (math.cos(0.5 * angle), s * tx, s * ty, s * tz)
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class StarTrackerParams:
     """Star tracker noise (1σ, arcsec) and boresight (unit vector in B)."""
@@ -105,7 +107,8 @@ class StarTrackerParams:
         put = object.__setattr__
         for key in ("noise_cross_arcsec", "noise_about_arcsec"):
             put(self, key, check_number(getattr(self, key), src, key, positive=False))
-        b = check_vec3(self.boresight_B, src, "boresight_B")
+        given = getattr(self, "boresight_B")  # noqa: B009 - uncast (see setup.py)
+        b = check_vec3(given, src, "boresight_B")
         if not abs(math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]) - 1.0) <= UNIT_NORM_TOL:
             raise ConfigError(
                 src,

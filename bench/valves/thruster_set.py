@@ -59,6 +59,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from bench.dynamics.rigid_body import Vec3, Wrench, quat_from_axis_angle, rotate_B_to_N
 from bench.valves.base import ValveModel
@@ -99,6 +100,7 @@ def _vec3(value: object, source: str, key: str) -> Vec3:
     return (seq[0], seq[1], seq[2])
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class ThrusterGeometry:
     """Mounting of one thruster: application point [m] and unit force direction, body axes."""
@@ -110,8 +112,9 @@ class ThrusterGeometry:
     """r × d [m]: torque per newton of thrust."""
 
     def __post_init__(self) -> None:
-        r = _vec3(self.r_thr_B_m, self.source, "r_thr_B_m")
-        d = _vec3(self.d_thr_B, self.source, "d_thr_B")
+        # getattr: the fields as given (compiled code would cast a read to Vec3 first)
+        r = _vec3(getattr(self, "r_thr_B_m"), self.source, "r_thr_B_m")  # noqa: B009
+        d = _vec3(getattr(self, "d_thr_B"), self.source, "d_thr_B")  # noqa: B009
         norm = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
         if not abs(norm - 1.0) <= UNIT_NORM_TOL:
             raise ConfigError(

@@ -98,6 +98,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from dbc.errors import ConfigError
 
@@ -209,6 +210,7 @@ def check_fault_params(
     return out
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class ValveParams:
     """Parameters of one thruster valve; times in seconds, validated on construction.

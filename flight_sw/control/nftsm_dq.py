@@ -68,6 +68,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+from mypy_extensions import mypyc_attr
 
 from dbc.errors import ConfigError
 from flight_sw import dual_quaternion as dq
@@ -316,6 +317,7 @@ def _sig1(x: float, abs_x: float, power: float) -> float:
     return 0.0 * x
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class NftsmDqParams:
     """Gains and nominal model of the NFTSM law; defaults are seed 000, Section V.

@@ -65,6 +65,8 @@ import math
 import numbers
 from dataclasses import dataclass
 
+from mypy_extensions import mypyc_attr
+
 from dbc.errors import ConfigError
 
 _SOURCE = "PwpfParams"
@@ -82,6 +84,7 @@ def _real(key: str, value: object, expected: str) -> float:
     return x
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class PwpfParams:
     """PWPF modulator parameters.

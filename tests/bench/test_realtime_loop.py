@@ -111,21 +111,25 @@ def _run(tmp_path: Path, duration_s: float, speedup: int,
     db = load_database()
     spec = f"virtual:rt-{uuid.uuid4().hex}"
     bus = open_bus(spec)
-    node = BenchNode(load_scenario(SCENARIO, overrides), db, bus, tmp_path, "realtime", 1, spec)
     counts = Counts()
-    recv, on_frame = bus.recv, node._on_realtime_frame
+
+    class CountingNode(BenchNode):
+        """Counts the frames the realtime loop hands to its frame handler."""
+
+        def _on_realtime_frame(self, msg: can.Message, clock: Clock) -> None:
+            counts.handled += 1
+            super()._on_realtime_frame(msg, clock)
+
+    scenario = load_scenario(SCENARIO, overrides)
+    node = CountingNode(scenario, db, bus, tmp_path, "realtime", 1, spec)
+    recv = bus.recv
 
     def counting_recv(timeout: float | None = None) -> can.Message | None:
         msg = recv(timeout=timeout)
         counts.delivered += msg is not None
         return msg
 
-    def counting_on_frame(msg: can.Message, clock: Clock) -> None:
-        counts.handled += 1
-        on_frame(msg, clock)
-
     node.bus.recv = counting_recv  # type: ignore[method-assign]
-    node._on_realtime_frame = counting_on_frame  # type: ignore[method-assign]
     stop = threading.Event()
     sender = threading.Thread(target=peer, args=(spec, stop, node.n_cmd_frames, counts.sent))
     # the run in a thread of its own, so that a bench that never ends fails the test

@@ -38,6 +38,7 @@ from bench.dynamics.rigid_body import (
     state_v_N,
 )
 from dbc.errors import ConfigError
+from tests.values import same_value
 
 DT_S = 1e-3
 TUMBLE_DURATION_S = 100.0
@@ -101,7 +102,7 @@ def test_mass_must_be_positive_finite(mass: float) -> None:
     assert exc.value.key == "mass_kg"
     assert "mass_kg" in str(exc.value)
     assert "vehicle.toml" in str(exc.value)
-    assert exc.value.value is mass
+    assert same_value(exc.value.value, mass)
 
 
 @pytest.mark.parametrize(

@@ -12,6 +12,7 @@ from bench.sensors.accelerometer import Accelerometer, AccelerometerParams
 from bench.sensors.gyro import Gyro, GyroParams
 from bench.sensors.star_tracker import RAD_PER_ARCSEC, StarTracker, StarTrackerParams
 from dbc.errors import ConfigError
+from tests.values import same_value
 
 SEED = 20240607
 N_SAMPLES = 20_000
@@ -240,7 +241,7 @@ def test_sensor_config_errors_name_key_and_value(cls: type, key: str, value: obj
     with pytest.raises(ConfigError) as exc:
         cls(**{key: value}, source="scenario.toml [sensors]")
     assert exc.value.key == key
-    assert exc.value.value is value
+    assert same_value(exc.value.value, value)
     assert key in str(exc.value)
     assert repr(value) in str(exc.value)
     assert str(exc.value).startswith("scenario.toml [sensors]")

@@ -16,6 +16,7 @@ from bench.valves.valve import (
     ValveParams,
 )
 from dbc.errors import ConfigError
+from tests.values import same_value
 
 MS = 1_000_000  # ns per millisecond
 FMAX_N = 22.0
@@ -83,7 +84,7 @@ def test_params_validation_names_key_and_value(key: str, value: float) -> None:
     with pytest.raises(ConfigError) as exc:
         ValveParams(**base, source="scenario.toml [thrusters]")
     assert exc.value.key == key
-    assert exc.value.value is value
+    assert same_value(exc.value.value, value)
     assert key in str(exc.value)
     assert repr(value) in str(exc.value)
     assert str(exc.value).startswith("scenario.toml [thrusters]")
