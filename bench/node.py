@@ -30,7 +30,7 @@ import numpy as np
 from cantools.database.can import Database
 from mypy_extensions import mypyc_attr
 
-from bench.bus.timing import INTERMISSION_BITS, BusArbiter, frame_bits, wire_time_ns
+from bench.bus.timing import INTERMISSION_BITS, BusArbiter, Delivery, frame_bits, wire_time_ns
 from bench.faults import (
     BUS_KINDS,
     NO_FATE,
@@ -570,7 +570,7 @@ class BenchNode:
         at their end, in time order with the frames delivered meanwhile.
         """
         rx: dict[int, int] = {}
-        entries: list[tuple[int, int, Any]] = []  # (time, 0 error / 1 frame, delivery)
+        entries: list[tuple[int, int, Delivery | None]] = []  # (time, 0 error / 1 frame, ...)
         errors = False
         for d in self.arbiter.resolve(until_ns):
             if d.failed_ns:
@@ -582,13 +582,13 @@ class BenchNode:
             self._last_rx_ns = max(self._last_rx_ns, t_rx)
         if errors:
             entries.sort(key=lambda e: (e[0], e[1]))  # stable: frames keep their wire order
-        for t, _kind, d in entries:
-            if d is None:
+        for t, _kind, frame in entries:  # not `d`: that name is a Delivery above
+            if frame is None:
                 self.trace.error_frame(t)
                 continue
-            msg, tx, bits = self._wire_pending.pop(d.seq)
-            self.trace.frame(msg, t, tx=tx, t_ready_ns=d.ready_ns, t_start_ns=d.start_ns,
-                             bits=bits)
+            msg, tx, bits = self._wire_pending.pop(frame.seq)
+            self.trace.frame(msg, t, tx=tx, t_ready_ns=frame.ready_ns,
+                             t_start_ns=frame.start_ns, bits=bits)
         return rx
 
     def _send_queue(self, realtime_ns: int | None = None) -> None:

@@ -151,6 +151,7 @@ class FlightNode:
         self.period_ns = cycle_time_ns(db, "THR_CMD_0")
         self.status_every = max(1, cycle_time_ns(db, "FSW_STATUS") // self.period_ns)
         self._stop = False
+        self._waiting = False  # blocked in the bus receive: a stop signal may interrupt
         self.lockstep_silence_heartbeat_s = LOCKSTEP_SILENCE_HEARTBEAT_S
         self._last_sync: int | None = None
         self._pending_seen: set[str] = set()
@@ -166,7 +167,9 @@ class FlightNode:
 
     # -- signals -----------------------------------------------------------------
     def install_signal_handlers(self) -> None:
-        """SIGTERM / SIGINT end the loop at once (even inside a blocking receive).
+        """SIGTERM / SIGINT end the loop: at once while blocked in a receive, else after the
+        current step (a frame being sent is sent and counted, so the statistics match what
+        the bench received).
 
         A second signal while stopping is ignored, so the statistics file is still written.
         """
@@ -175,7 +178,8 @@ class FlightNode:
             if self._stop:  # already stopping (e.g. Ctrl-C, then the bench's SIGTERM):
                 return  # let the statistics be written
             self._stop = True
-            raise StopRequested(signum)
+            if self._waiting:
+                raise StopRequested(signum)
 
         signal.signal(signal.SIGTERM, _handler)
         signal.signal(signal.SIGINT, _handler)
@@ -191,6 +195,16 @@ class FlightNode:
             pass
         finally:
             self.write_stats()
+
+    def _recv(self, timeout_s: float) -> can.Message | None:
+        """``bus.recv`` that a stop signal may interrupt (see install_signal_handlers)."""
+        self._waiting = True
+        try:
+            if self._stop:
+                raise StopRequested(0)
+            return self.bus.recv(timeout=timeout_s)
+        finally:
+            self._waiting = False
 
     # -- transmit ----------------------------------------------------------------
     def _send(self, name: str, signals: dict[str, float | int]) -> None:
@@ -368,7 +382,7 @@ class FlightNode:
         while not self._stop:
             silence_s = (HEARTBEAT_RETRY_S if self._last_sync is None
                          else self.lockstep_silence_heartbeat_s)
-            msg = self.bus.recv(timeout=silence_s)
+            msg = self._recv(silence_s)
             if msg is None:
                 self._heartbeat()
                 continue
@@ -420,7 +434,7 @@ class FlightNode:
                 phased_base = base
                 next_ns = _next_phase_ns(now, base, period, self.fc.cycle_phase_ns)
             if now < next_ns:
-                msg = self.bus.recv(timeout=(next_ns - now) / 1e9)
+                msg = self._recv((next_ns - now) / 1e9)
                 if msg is not None:
                     if self.rx_log is not None:
                         self.rx_log.row(msg)

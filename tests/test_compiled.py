@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import ast
 import importlib
+import importlib.machinery
 import importlib.util
 import os
 import sys
@@ -59,11 +60,13 @@ def test_compiled_module_is_built_and_fresh(path: str) -> None:
     """Each listed module imports as an extension no older than its source."""
     if PURE:
         pytest.skip("THRUSTER_HIL_PURE=1: a pure-Python install")
-    spec = importlib.util.find_spec(_module_name(path))
-    assert spec is not None and spec.origin is not None
-    built = Path(spec.origin)  # the extension Python loads (a compiled __file__ is synthetic)
-    assert built.suffix == ".so", f"{path}: not compiled ({built}); run `pip install -e .`"
     source = REPO / path
+    # what the import system finds on disk (not sys.modules: a module imported by another
+    # compiled one has a synthetic __spec__ and __file__)
+    spec = importlib.machinery.PathFinder.find_spec(_module_name(path), [str(source.parent)])
+    assert spec is not None and spec.origin is not None
+    built = Path(spec.origin)
+    assert built.suffix == ".so", f"{path}: not compiled ({built}); run `pip install -e .`"
     assert built.stat().st_mtime >= source.stat().st_mtime, (
         f"{path} changed after {built.name} was built: rerun `pip install -e .`"
     )
