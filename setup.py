@@ -1,10 +1,11 @@
-"""Build hook: compiles the bench's hot-path modules to C extensions with mypyc.
+"""Build hook: compiles the hot-path modules to C extensions with mypyc.
 
 What and why
-    The modules in :data:`COMPILED` (rigid-body RK4, valve and thruster-set wrenches, CAN
-    bit timing, E2E CRC, signal packing) are plain, fully typed Python. mypyc (mypy's
-    compiler, https://mypyc.readthedocs.io) turns each into a C extension that Python
-    imports instead of the ``.py`` beside it; the arithmetic is the same IEEE double
+    The modules in :data:`COMPILED` (bench: rigid-body RK4, valves and thruster set, CAN
+    bit timing, plant, sensors, the bench loop, recorder; dbc: E2E CRC, signal packing;
+    flight_sw: quaternions, dual quaternions, NFTSM, PWPF) are plain, fully typed Python.
+    mypyc (mypy's compiler, https://mypyc.readthedocs.io) turns each into a C extension
+    that Python imports instead of the ``.py`` beside it; the arithmetic is the same IEEE double
     arithmetic in the same order (no fused multiply-add on the x86-64 baseline), so
     results are bit-identical (``tests/test_compiled.py`` checks compiled against the
     source on known inputs). ``benchmarks/compiled_speedup.py`` measures the gain.
@@ -21,6 +22,9 @@ Rules for a compiled module (what differs from the interpreter, each met in this
       a 2-vector would raise TypeError instead of the ConfigError naming it).
     - No identity tests on values (``f is not win`` on tuples, ``value is mass`` on
       floats): compiled tuples and floats are unboxed, so compare by value.
+    - A name keeps one type in a function: compiled code enforces the type mypy inferred
+      at its first binding (a loop variable that was a ``Delivery`` cannot later be the
+      ``None`` of an ``Any``-typed tuple).
     - Native classes cannot be monkeypatched; a class that tests (or users) extend is
       marked ``@mypyc_attr(allow_interpreted_subclasses=True)`` and extended by subclassing.
 
