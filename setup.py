@@ -47,6 +47,7 @@ COMPILED = [
     "bench/bus/timing.py",
     "dbc/e2e.py",
     "dbc/layout.py",
+    "dbc/codec.py",
     "bench/plant.py",
     "bench/sensors/gyro.py",
     "bench/sensors/accelerometer.py",

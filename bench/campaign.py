@@ -3,13 +3,14 @@
 ``python -m bench.campaign SCENARIO --out DIR [--fault-time S] [--jobs N] [--kinds ...]``
 (also ``thruster-hil campaign``). Each run is the scenario with one ``[[faults]]`` entry
 appended, started as its own ``thruster-hil run`` process on a private portable-bus channel,
-``--jobs`` at a time. The flight software's FDIR report (FSW_FDIR, in each summary.json)
-gives detection and isolation. Out, in DIR: ``campaign.csv`` (one row per run: thruster,
-kind, detected, detection time after the fault, isolated thruster, isolation correct,
-expectations met, final attitude and position error, propellant), ``campaign.json`` and
-``campaign.png`` (detection time per thruster and kind), plus every run folder. Exit 0 if
-every run detected and isolated its failure and met the scenario's expectations, 1 if not,
-2 on bad input, 3 if a run could not complete.
+``--jobs`` at a time (with more processes than CPUs, their lockstep waits block at once
+instead of polling first: see dbc.bus). The flight software's FDIR report (FSW_FDIR, in each
+summary.json) gives detection and isolation. Out, in DIR: ``campaign.csv`` (one row per run:
+thruster, kind, detected, detection time after the fault, isolated thruster, isolation
+correct, expectations met, final attitude and position error, propellant), ``campaign.json``
+and ``campaign.png`` (detection time per thruster and kind), plus every run folder. Exit 0
+if every run detected and isolated its failure and met the scenario's expectations, 1 if
+not, 2 on bad input, 3 if a run could not complete.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.scenario import load_scenario
+from dbc.bus import LOCKSTEP_SPIN_ENV, available_cpus
 from dbc.errors import ConfigError, RunError
 
 KINDS = ("stuck_closed", "stuck_open")
@@ -36,14 +38,17 @@ COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruste
            "isolation_correct", "expectations_met", "final_attitude_error_deg",
            "final_position_error_m", "propellant_kg", "run_dir"]
 DPI = 110
+PROCESSES_PER_RUN = 2  # bench + flight software
 
 
-def _run_one(scenario: Path, fault: str, out: Path, xdg: Path) -> dict[str, Any]:
+def _run_one(scenario: Path, fault: str, out: Path, xdg: Path, spin_off: bool) -> dict[str, Any]:
     out.mkdir(parents=True, exist_ok=True)
     text = scenario.read_text(encoding="utf-8").rstrip() + "\n" + fault
     sc_file = out / "campaign_scenario.toml"
     sc_file.write_text(text, encoding="utf-8")
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
+    if spin_off:  # more processes than CPUs: a polling wait would hold a CPU another needs
+        env.setdefault(LOCKSTEP_SPIN_ENV, "0")
     p = subprocess.run(
         [sys.executable, "-m", "bench.cli", "run", str(sc_file), "--bus",
          f"hilbus:c{uuid.uuid4().hex[:10]}", "--out", str(out / "run")],
@@ -85,6 +90,7 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
     n = len(sc.thrusters)
     out.mkdir(parents=True, exist_ok=True)
     cases = [(k, kind) for kind in kinds for k in range(n)]
+    spin_off = PROCESSES_PER_RUN * min(jobs, len(cases)) > available_cpus()
     with tempfile.TemporaryDirectory(prefix="thil-campaign-") as tmp:
         xdg = Path(tmp)
         xdg.chmod(0o700)
@@ -93,7 +99,8 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
             k, kind = case
             d = out / f"{kind}_T{k:02d}"
             fault = f'\n[[faults]]\nt_s = {fault_t_s}\nkind = "{kind}"\nthruster = {k}\n'
-            return _row(k, kind, fault_t_s, _run_one(scenario, fault, d, xdg), d / "run")
+            return _row(k, kind, fault_t_s, _run_one(scenario, fault, d, xdg, spin_off),
+                        d / "run")
 
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             futures = [pool.submit(job, case) for case in cases]

@@ -10,7 +10,10 @@ delivers them to the valves at the time the bus model says they arrive (flight-s
 response delay from the scenario, then arbitration and exact frame length), and
 integrates to t_{k+1}. A missing answer within ``stall_timeout_s`` of wall time is a counted
 stall; after ``SILENT_AFTER_STALLS`` stalls in a row the flight software is declared silent
-and the bench stops waiting (never hangs). Realtime: the bench paces the plant to its own
+and the bench stops waiting (never hangs). In lockstep the samples of a control instant go
+to the bus together with its SYNC (one burst on hilbus), samples between control instants
+as soon as they are taken, and the run files' text is formatted while the flight software
+computes (bench/recorder.py, deferred writing). Realtime: the bench paces the plant to its own
 monotonic clock, sends sensors when due and applies commands when they arrive; all
 latencies are measured. Valve watchdog: no valid command for ``WATCHDOG_PERIODS`` command
 periods closes every valve and records the event.
@@ -51,6 +54,7 @@ from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
 from bench.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
 from bench.scenario import Scenario
+from dbc.bus import recv_spinning, send_frames
 from dbc.codec import Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.errors import RunError
 from dbc.quaternion import pack_quaternion, unpack_quaternion
@@ -61,6 +65,7 @@ FAULT_CMD_NONE = 15  # BENCH_STATUS.FaultCmdCounter before any FAULT_CMD
 FAULT_RNG_STREAM = 0xFA  # spawn key of the fault-injection random stream
 BENCH_NODE = "BENCH"
 STARTUP_POLL_S = 0.2
+FLUSH_EVERY_CYCLES = 5  # run files go to disk this often (and the progress line is updated)
 SILENT_AFTER_STALLS = 3
 THRUSTERS_PER_CMD_FRAME = 4
 RT_FRAMES_PER_PASS = 64  # realtime: frames read between two steps toward the wall clock
@@ -203,14 +208,21 @@ class BenchNode:
         self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
         self.arbiter = BusArbiter(sc.bus.bitrate_bps)
         self._intermission_ns = wire_time_ns(INTERMISSION_BITS, sc.bus.bitrate_bps)
-        self.trace = TraceRecorder(run_dir, Clock().wall0_s)
-        self.telemetry = TelemetryWriter(run_dir / "telemetry.csv", self._columns())
-        self.chains = TelemetryWriter(run_dir / "chains.csv", CHAIN_COLUMNS)
+        # Lockstep: the files' text is formatted while the flight software computes
+        # (write_pending before waiting for its commands), not between its frames.
+        deferred = mode == "lockstep"
+        self.trace = TraceRecorder(run_dir, Clock().wall0_s, deferred)
+        self.telemetry = TelemetryWriter(run_dir / "telemetry.csv", self._columns(), deferred)
+        self.chains = TelemetryWriter(run_dir / "chains.csv", CHAIN_COLUMNS, deferred)
         self.open_delay_ns = round(sc.valve.open_delay_s * NS_PER_S)
         self._rt_fire_ns: int | None = None
         self.pulses = TelemetryWriter(
-            run_dir / "valve_pulses.csv", ["t_on_s", "t_off_s", "thruster"]
+            run_dir / "valve_pulses.csv", ["t_on_s", "t_off_s", "thruster"], deferred
         )
+        # Lockstep: frames put on the bus wait here until released together (one burst on
+        # a bus that takes bursts): a control instant's samples go out with its SYNC.
+        self._tx_held: list[can.Message] = []
+        self._hold_tx = deferred
         self.sent: dict[str, int] = {}
         self.queue: list[tuple[int, int, str, dict[str, float | int]]] = []
         self.imu_tx_ns: dict[int, int] = {}
@@ -245,6 +257,11 @@ class BenchNode:
         self.fault_rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
         self.sender_of = {m.name: (m.senders[0] if m.senders else "") for m in db.messages}
         self.name_of = {m.frame_id: m.name for m in db.messages}
+        # THR_STATUS signal names per thruster (Cmd, Open, Current), and all of them
+        self._status_signals = [str(s.name) for s in db.get_message_by_name("THR_STATUS").signals
+                                if s.name not in ("CRC", "AliveCounter")]
+        self._status_names = [(f"Cmd_T{k:02d}", f"Open_T{k:02d}", f"Current_T{k:02d}")
+                              for k in range(self.n_thr)]
         self.on_time_last = [0.0] * self.n_thr
         self.tel_t: list[float] = []
         self.tel_err: list[float] = []
@@ -252,6 +269,11 @@ class BenchNode:
         # distance from the reference position ([manoeuvre] r_target_N_m, else the initial one)
         self.tel_pos_err: list[float] = []
         self.wall_s = 0.0
+        # lockstep, per cycle: wall time of the whole cycle, and of the wait for the flight
+        # software's commands within it (the rest is the bench's own work)
+        self.cycle_wall_ns: list[int] = []
+        self.fsw_wait_ns: list[int] = []
+        self.lockstep_spin_s = 0.0  # poll this long before blocking for commands (dbc.bus)
         self.fsw_alive: Callable[[], bool] | None = None
         self._wire_pending: dict[int, tuple[can.Message, bool, int]] = {}
         self.last_sync_ns = 0  # lockstep: time of the run's last SYNC
@@ -338,15 +360,10 @@ class BenchNode:
             return {"Valid": int(ok), "VelX": _clip(vel[0], NAV_VEL_MAX_M_S),
                     "VelY": _clip(vel[1], NAV_VEL_MAX_M_S), "VelZ": _clip(vel[2], NAV_VEL_MAX_M_S)}
         if name == "THR_STATUS":
-            sig: dict[str, float | int] = {}
+            sig: dict[str, float | int] = dict.fromkeys(self._status_signals, 0)
+            names = self._status_names
             for k, (cmd, opn, cur) in enumerate(p.thrusters.status(t_ns)):
-                sig[f"Cmd_T{k:02d}"], sig[f"Open_T{k:02d}"], sig[f"Current_T{k:02d}"] = (
-                    int(cmd),
-                    int(opn),
-                    int(cur),
-                )
-            for k in range(self.n_thr, 16):
-                sig[f"Cmd_T{k:02d}"] = sig[f"Open_T{k:02d}"] = sig[f"Current_T{k:02d}"] = 0
+                sig[names[k][0]], sig[names[k][1]], sig[names[k][2]] = int(cmd), int(opn), int(cur)
             return sig
         # BENCH_STATUS
         health = (HEALTH_WATCHDOG if self.watchdog_tripped else 0) | (
@@ -490,6 +507,8 @@ class BenchNode:
             elif self.queue and self.mode == "lockstep":
                 if t <= self.last_sync_ns:
                     self._send_queue()
+                    if t % self.period_ns:  # between control instants: out at once; at
+                        self._release_tx()  # one, with its SYNC (run_lockstep)
                 else:  # sampled after the last SYNC of the run: that cycle never comes
                     self.queue.clear()
 
@@ -527,7 +546,10 @@ class BenchNode:
 
     def _put_on_bus(self, msg: can.Message, name: str, ready_ns: int, realtime_ns: int | None,
                     failed_attempts: int = 0) -> None:
-        self.bus.send(msg)
+        if self._hold_tx:
+            self._tx_held.append(msg)
+        else:
+            self.bus.send(msg)
         self.sent[name] = self.sent.get(name, 0) + 1
         bits = frame_bits(msg.arbitration_id, bytes(msg.data))
         if realtime_ns is not None:
@@ -556,7 +578,10 @@ class BenchNode:
                 data = bytes(self.fault_rng.integers(0, 256, 8, dtype=np.uint8))
                 msg = can.Message(arbitration_id=int(f.params["can_id"]), is_extended_id=False,
                                   data=data)
-                self.bus.send(msg)
+                if self._hold_tx:
+                    self._tx_held.append(msg)
+                else:
+                    self.bus.send(msg)
                 self.fault_counts["babbled"] += 1
                 bits = frame_bits(msg.arbitration_id, data)
                 seq = self.arbiter.submit(t, msg.arbitration_id, bits, node=str(f.node))
@@ -596,6 +621,26 @@ class BenchNode:
         for t_ns, _id, name, sig in self.queue:
             self._send(name, sig, t_ns, realtime_ns)
         self.queue.clear()
+
+    def _release_tx(self) -> None:
+        """Hand the held frames to the bus, in order, together (see dbc.bus.send_frames)."""
+        if self._tx_held:
+            send_frames(self.bus, self._tx_held)
+            self._tx_held = []
+
+    def _flush_files(self) -> None:
+        """Flush the run files to disk (a crash loses at most the last few cycles)."""
+        self.trace.flush()
+        self.telemetry.flush()
+        self.pulses.flush()
+        self.chains.flush()
+
+    def _write_pending(self) -> None:
+        """Format the run files' deferred rows and trace lines (lockstep)."""
+        self.trace.write_pending()
+        self.telemetry.write_pending()
+        self.pulses.write_pending()
+        self.chains.write_pending()
 
     def _on_fsw_frame(self, d_name: str, s: dict[str, float], counter: int = 0) -> None:
         if d_name == "FAULT_CMD":
@@ -727,22 +772,21 @@ class BenchNode:
         self._telemetry_row(0)
         for k in range(n_cycles):
             t_k = k * self.period_ns
+            cycle_wall0_ns = time.monotonic_ns()
             self._send_queue()
             # SYNC closes the samples of (t_{k-1}, t_k]: it is queued once they are through,
             # and the flight software's cycle starts when SYNC has arrived.
             self._flush_wire()
             self._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S},
                        max(t_k, self._last_rx_ns))
+            self._release_tx()
             self._flush_wire()
             self._collect_lockstep(k, self._last_rx_ns + delay_ns)
             self.integrate_to(t_k + self.period_ns)
-            if k % 5 == 0:
-                self.trace.flush()
-                self.telemetry.flush()
-                self.pulses.flush()
-                self.chains.flush()
-                if self.progress is not None:
-                    self.progress(t_k / NS_PER_S, duration_s)
+            if k % FLUSH_EVERY_CYCLES == 0 and self.progress is not None:
+                self.progress(t_k / NS_PER_S, duration_s)
+            self.cycle_wall_ns.append(time.monotonic_ns() - cycle_wall0_ns)
+        self._release_tx()
         self._flush_wire()
         self.queue.clear()
         self.wall_s = time.monotonic() - wall0
@@ -755,16 +799,21 @@ class BenchNode:
         self.integrate_to(max(self.plant.t_ns, ready_ns // STEP_NS * STEP_NS))
         self._flush_wire(ready_ns)
         self._babble(k * self.period_ns, (k + 1) * self.period_ns)
+        self._release_tx()  # delayed frames released meanwhile
+        self._write_pending()
+        if k % FLUSH_EVERY_CYCLES == 0:
+            self._flush_files()
         want = self.n_cmd_frames
         got: list[tuple[int, int, dict[str, float], int]] = []  # (frame, seq, signals, delay)
         lost = 0  # command frames that faults kept from the bench this cycle
         fsw_dead = self.fsw_alive is not None and not self.fsw_alive()
         timeout = 0.0 if (self.fsw_silent or fsw_dead) else self.sc.bus.stall_timeout_s
+        wait0_ns = time.monotonic_ns()
         deadline = time.monotonic() + timeout
         imu_counter = None
         while len(got) + lost < want:
             remaining = deadline - time.monotonic()
-            msg = self.bus.recv(timeout=max(0.0, remaining))
+            msg = recv_spinning(self.bus, max(0.0, remaining), self.lockstep_spin_s)
             if msg is None:
                 break
             name = self.name_of.get(msg.arbitration_id)
@@ -806,6 +855,7 @@ class BenchNode:
                     imu_counter = int(s["ImuCounter"])
                 else:
                     self._on_fsw_frame(d.name, s, d.counter)
+        self.fsw_wait_ns.append(time.monotonic_ns() - wait0_ns)
         rx = self._flush_wire(ready_ns + self.period_ns)
         if len(got) + lost < want:
             self.stalls += 1
@@ -1037,6 +1087,11 @@ class BenchNode:
             "frames": frames,
             "rejected_other": other,
             "latency_us": {"sensor_to_command": latency_summary(self.latency_ns)},
+            "lockstep_wall_us": None if self.mode != "lockstep" else {
+                "cycle": latency_summary(self.cycle_wall_ns),
+                "waiting_for_fsw": latency_summary(self.fsw_wait_ns),
+                "spin_s": self.lockstep_spin_s,
+            },
             "deadline_misses": {
                 "bench_late": self.late_steps,
                 "bench_max_lag_ms": round(self.max_lag_ns / 1e6, 3),

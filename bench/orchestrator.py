@@ -39,7 +39,7 @@ from bench.plausibility import mass_warnings
 from bench.recorder import write_summary
 from bench.scenario import Scenario
 from dbc import load_database
-from dbc.bus import mode_options, open_bus
+from dbc.bus import available_cpus, lockstep_spin_s, mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 from dbc.hilbus import MEMBER_STALL_S
@@ -133,6 +133,7 @@ def run_scenario(
     if opts.fsw_cmd is not None:
         _fsw_argv(opts.fsw_cmd, opts, out, out)  # a bad placeholder: exit 2 before anything runs
     check_bus(opts.bus)
+    spin_s = lockstep_spin_s(available_cpus(), os.environ) if opts.mode == "lockstep" else 0.0
     try:
         out.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(sc.path, out / "scenario.toml")
@@ -143,7 +144,7 @@ def run_scenario(
                           f"a folder this user can create and write ({exc.strerror or exc})"
                           ) from exc
     if not hasattr(os, "fork"):  # pragma: no cover - no supervisor where fork is missing
-        return _run_bench(sc, opts, progress, ready, config)
+        return _run_bench(sc, opts, progress, ready, config, spin_s)
     pid = os.fork()
     if pid == 0:  # the bench process
         code = EXIT_CHILD_OK
@@ -151,7 +152,7 @@ def run_scenario(
             _die_with_parent()
             signal.signal(signal.SIGTERM, _terminate)
             (out / "bench.pid").write_text(f"{os.getpid()}\n", encoding="utf-8")
-            _run_bench(sc, opts, progress, ready, config)
+            _run_bench(sc, opts, progress, ready, config, spin_s)
         except ConfigError as exc:
             code = EXIT_CHILD_BAD_INPUT
             if not (out / "summary.json").exists():  # refused before the run: say why
@@ -201,14 +202,20 @@ def _run_bench(
     progress: Callable[[float, float], None] | None,
     ready: Callable[[Path], None] | None,
     config: Path,
+    spin_s: float = 0.0,
 ) -> dict[str, Any]:
-    """The bench process: run, then write summary.json and plots (whatever happened)."""
+    """The bench process: run, then write summary.json and plots (whatever happened).
+
+    ``spin_s``: lockstep, how long to poll for the flight software's answer before blocking
+    (dbc.bus.lockstep_spin_s; our flight software works its own out the same way).
+    """
     out = opts.out
     stats = out / "fsw_stats.json"
     db = load_database()
     bus = open_bus(opts.bus, **mode_options(opts.bus, opts.mode))
     proc: subprocess.Popen[bytes] | None = None
     node = BenchNode(sc, db, bus, out, opts.mode, opts.seed, opts.bus, progress)
+    node.lockstep_spin_s = spin_s
     if ready is not None:
         ready(config)
     error: BaseException | None = None

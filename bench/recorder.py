@@ -15,6 +15,12 @@
   newest IMU_RATE used (its transmit time), last THR_CMD reception, first valve opening.
 * ``events.jsonl`` — one JSON object per event (faults, watchdog, stalls), flushed per line.
 
+Deferred writing (``deferred=True``, the lockstep bench): rows and trace lines are kept as
+values and formatted into the files by :meth:`write_pending` (also called by ``flush`` and
+``close``), so that a bench can do the text formatting while the flight software computes
+its cycle instead of between its frames. The files' content is the same either way;
+``events.jsonl`` is always written and flushed at once.
+
 No clock is read here: every timestamp is passed in (the trace's start date too).
 """
 
@@ -41,15 +47,20 @@ FRAME_COLUMNS = ["t_ready_s", "t_start_s", "t_rx_s", "id", "dlc", "bits", "tx", 
 # fires a valve received, that valve opening (nan: no valve fired)
 CHAIN_COLUMNS = ["cycle", "imu_counter", "t_imu_tx_s", "t_cmd_rx_s", "t_fire_cmd_rx_s",
                  "t_valve_open_s"]
+PENDING_FRAME, PENDING_ERROR, PENDING_EVENT = 0, 1, 2  # kinds of a deferred trace line
 NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at 1e4 s
 
 
 class TraceRecorder:
     """CAN trace in Vector ASC format, plus an events log."""
 
-    def __init__(self, run_dir: Path, start_wall_s: float) -> None:
-        """``start_wall_s``: wall-clock time of the run's start (``time.time()`` seconds)."""
+    def __init__(self, run_dir: Path, start_wall_s: float, deferred: bool = False) -> None:
+        """``start_wall_s``: wall-clock time of the run's start (``time.time()`` seconds);
+        ``deferred``: keep frames and events until :meth:`write_pending` (module docstring)."""
         self.path = run_dir / "trace.asc"
+        self.deferred = deferred
+        # (kind, t_ns, message or None, tx, event text): in trace order until written
+        self._pending: list[tuple[int, int, can.Message | None, bool, str]] = []
         self._writer = w = can.ASCWriter(str(self.path), channel=1)
         # The trigger block is dated when the run started (metadata, as the file's "date"
         # line); frame times stay run time, relative to it. Left to python-can, it is dated
@@ -61,7 +72,7 @@ class TraceRecorder:
         w.started = w.last_timestamp = 0.0
         w.log_event("Start of measurement")
         self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
-        self._frames = TelemetryWriter(run_dir / "frames.csv", FRAME_COLUMNS)
+        self._frames = TelemetryWriter(run_dir / "frames.csv", FRAME_COLUMNS, deferred)
         self.frames_written = 0
 
     def frame(
@@ -81,7 +92,14 @@ class TraceRecorder:
         self._frames.row([t_ready_ns / NS_PER_S, t_start_ns / NS_PER_S,
                           (t_ns if t_rx_ns is None else t_rx_ns) / NS_PER_S,
                           msg.arbitration_id, msg.dlc, bits, int(tx), counter])
-        rec = can.Message(
+        self.frames_written += 1
+        if self.deferred:
+            self._pending.append((PENDING_FRAME, t_ns, msg, tx, ""))
+        else:
+            self._write_frame(t_ns, msg, tx)
+
+    def _write_frame(self, t_ns: int, msg: can.Message, tx: bool) -> None:
+        self._writer.on_message_received(can.Message(
             timestamp=t_ns / NS_PER_S,
             arbitration_id=msg.arbitration_id,
             is_extended_id=msg.is_extended_id,
@@ -91,15 +109,19 @@ class TraceRecorder:
             data=msg.data,
             is_rx=not tx,
             channel=0,
-        )
-        self._writer.on_message_received(rec)
-        self.frames_written += 1
+        ))
 
     def error_frame(self, t_ns: int) -> None:
         """An error frame on the bus at ``t_ns`` (ASC ``ErrorFrame`` line)."""
+        self.frames_written += 1
+        if self.deferred:
+            self._pending.append((PENDING_ERROR, t_ns, None, False, ""))
+        else:
+            self._write_error(t_ns)
+
+    def _write_error(self, t_ns: int) -> None:
         self._writer.on_message_received(
             can.Message(timestamp=t_ns / NS_PER_S, is_error_frame=True, channel=0))
-        self.frames_written += 1
 
     def event(self, t_ns: int, what: str, /, **fields: Any) -> None:
         """Append one event line (``what`` at ``t_ns`` with ``fields``) and flush it."""
@@ -107,15 +129,33 @@ class TraceRecorder:
         self._events.flush()
         if what in TRACE_EVENTS:  # also in the CAN trace, as an ASC event line
             text = " ".join(f"{k}={v}" for k, v in fields.items() if k != "t_s")
-            self._writer.log_event(f"thruster-hil {what} {text}".rstrip(), t_ns / NS_PER_S)
+            line = f"thruster-hil {what} {text}".rstrip()
+            if self.deferred:
+                self._pending.append((PENDING_EVENT, t_ns, None, False, line))
+            else:
+                self._writer.log_event(line, t_ns / NS_PER_S)
+
+    def write_pending(self) -> None:
+        """Format what deferred writing kept into the files (in trace order); not flushed."""
+        for kind, t_ns, msg, tx, line in self._pending:
+            if msg is not None:
+                self._write_frame(t_ns, msg, tx)
+            elif kind == PENDING_ERROR:
+                self._write_error(t_ns)
+            else:
+                self._writer.log_event(line, t_ns / NS_PER_S)
+        self._pending.clear()
+        self._frames.write_pending()
 
     def flush(self) -> None:
         """Flush the trace and the frame timing to disk."""
+        self.write_pending()
         self._writer.file.flush()
         self._frames.flush()
 
     def close(self) -> None:
         """Finish every file."""
+        self.write_pending()
         self._writer.stop()
         self._frames.close()
         self._events.close()
@@ -124,8 +164,11 @@ class TraceRecorder:
 class TelemetryWriter:
     """``telemetry.csv`` with a fixed column list, flushed on demand."""
 
-    def __init__(self, path: Path, columns: list[str]) -> None:
+    def __init__(self, path: Path, columns: list[str], deferred: bool = False) -> None:
+        """``deferred``: keep rows until :meth:`write_pending` (see the module docstring)."""
         self.path = path
+        self.deferred = deferred
+        self._pending: list[list[float | int]] = []
         self._file: IO[str] = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
         csv.writer(self._file).writerow(columns)
         self.columns = columns
@@ -133,14 +176,26 @@ class TelemetryWriter:
 
     def row(self, values: list[float | int]) -> None:
         """Append one row of numbers (same order as the columns), 10 significant digits."""
-        self._file.write(self._fmt % tuple(values))
+        if self.deferred:
+            self._pending.append(values)
+        else:
+            self._file.write(self._fmt % tuple(values))
+
+    def write_pending(self) -> None:
+        """Format the rows deferred writing kept into the file; not flushed."""
+        if self._pending:
+            fmt = self._fmt
+            self._file.write("".join([fmt % tuple(v) for v in self._pending]))
+            self._pending.clear()
 
     def flush(self) -> None:
         """Flush to disk."""
+        self.write_pending()
         self._file.flush()
 
     def close(self) -> None:
         """Close the file."""
+        self.write_pending()
         self._file.close()
 
 

@@ -4,10 +4,15 @@ What it does: for one DBC message, turns physical signal values into the payload
 and back, exactly as cantools' ``Message.encode(values, scaling=True, strict=False)`` and
 ``Message.decode(data, decode_choices=False, scaling=True)`` do, without their per-call
 generality (choices, multiplexing, containers, truncation, argument checks). The bit
-positions are cantools' own compiled ``bitstruct`` formats
-(``cantools.database.utils.create_encode_decode_formats``) and the scale, offset and
-range of every signal are read from the cantools ``Signal`` objects, so the DBC stays the
-only place an ID, a position or a scale factor is written.
+positions, scale, offset and range of every signal are read from the cantools ``Signal``
+objects, so the DBC stays the only place an ID, a position or a scale factor is written.
+
+How: when every signal is a little-endian (Intel) integer field, as in ``thruster_hil.dbc``,
+the payload is one little-endian integer and each signal a bit field of it, masked and
+shifted with positions read from the cantools ``Signal`` (``start``, ``length``,
+``is_signed``); otherwise (big-endian or IEEE-float signals) cantools' own compiled
+``bitstruct`` formats (``cantools.database.utils.create_encode_decode_formats``) pack and
+unpack. Both give cantools' bytes and values exactly.
 
 In: a ``cantools`` ``Message`` (not multiplexed: every frame of ``thruster_hil.dbc``).
 Out (:meth:`FrameLayout.pack`): an ``bytearray`` of the message's length, CRC and alive
@@ -59,6 +64,15 @@ class FrameLayout:
         formats = create_encode_decode_formats(message.signals, message.length)
         self._big = formats.big_endian
         self._little = formats.little_endian
+        # bit fields of one little-endian integer, when every signal is one (see above)
+        self._fields = all(s.byte_order == "little_endian" and not s.conversion.is_float
+                           for s in message.signals)
+        self._names = [str(s.name) for s in message.signals]
+        self._shifts = [int(s.start) for s in message.signals]
+        self._masks = [(1 << int(s.length)) - 1 for s in message.signals]
+        self._sign_bits = [1 << (int(s.length) - 1) if s.is_signed else 0
+                           for s in message.signals]
+        self._modes = [_mode(s) for s in message.signals]
         inf = float("inf")
         # encoding: (name, lo, hi, scale, offset, to_int) for identity and linear signals
         # (identity = scale 1, offset 0, exactly), (name, lo, hi, conversion) for the others
@@ -84,6 +98,8 @@ class FrameLayout:
 
         ``source``: what to quote in an error (default ``values``).
         """
+        if self._fields:
+            return self._pack_fields(values, source)
         raw: dict[str, int | float] = {}
         try:
             for name, lo, hi, scale, offset, to_int in self._enc:
@@ -104,6 +120,28 @@ class FrameLayout:
             raise self._error(values, source, exc) from None
         return bytearray(packed.to_bytes(self.length, "big"))
 
+    def _pack_fields(self, values: Mapping[str, Any], source: Mapping[str, Any] | None
+                     ) -> bytearray:
+        """``pack`` for a message of little-endian integer fields only."""
+        raw: dict[str, int] = {}
+        try:
+            for name, lo, hi, scale, offset, _to_int in self._enc:
+                v = values[name]
+                if not lo <= v <= hi:
+                    raise ValueError(name)
+                raw[name] = round((v - offset) / scale)
+            for name, lo, hi, conv in self._enc_other:
+                v = values[name]
+                if not lo <= v <= hi:
+                    raise ValueError(name)
+                raw[name] = int(conv.numeric_scaled_to_raw(v))
+            payload = 0
+            for i, name in enumerate(self._names):
+                payload |= (raw[name] & self._masks[i]) << self._shifts[i]
+        except Exception as exc:  # the slow path: say which value and why
+            raise self._error(values, source, exc) from None
+        return bytearray(payload.to_bytes(self.length, "little"))
+
     def _error(self, values: Mapping[str, Any], source: Mapping[str, Any] | None,
                exc: Exception) -> IcdError:
         """The IcdError for a ``pack`` that failed with ``exc``: the first bad signal."""
@@ -121,10 +159,29 @@ class FrameLayout:
 
     def unpack(self, data: bytes | bytearray) -> dict[str, Any]:
         """Physical signal values of a payload of exactly ``length`` bytes."""
+        if self._fields:
+            return self._unpack_fields(data)
         unpacked = {**self._big.unpack(data), **self._little.unpack(data[::-1])}
         out: dict[str, Any] = {}
         for name, mode, scale, offset, conv in self._dec:
             raw = unpacked[name]
+            if mode == IDENTITY:
+                out[name] = raw
+            elif mode == LINEAR:
+                out[name] = raw * scale + offset
+            else:
+                out[name] = conv.raw_to_scaled(raw, False)
+        return out
+
+    def _unpack_fields(self, data: bytes | bytearray) -> dict[str, Any]:
+        """``unpack`` for a message of little-endian integer fields only."""
+        payload = int.from_bytes(data, "little")
+        out: dict[str, Any] = {}
+        for i, (name, mode, scale, offset, conv) in enumerate(self._dec):
+            raw = (payload >> self._shifts[i]) & self._masks[i]
+            sign = self._sign_bits[i]
+            if raw & sign:
+                raw -= sign << 1
             if mode == IDENTITY:
                 out[name] = raw
             elif mode == LINEAR:

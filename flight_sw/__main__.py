@@ -13,11 +13,12 @@ import argparse
 import contextlib
 import gc
 import json
+import os
 import sys
 from pathlib import Path
 
 from dbc import load_database
-from dbc.bus import default_bus_spec, mode_options, open_bus
+from dbc.bus import available_cpus, default_bus_spec, lockstep_spin_s, mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.errors import BusError, ConfigError
 from flight_sw.config import build_computer, load_config
@@ -61,6 +62,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.check:
             print(f"{args.config}: configuration ok")
             return 0
+        spin_s = lockstep_spin_s(available_cpus(), os.environ) if args.mode == "lockstep" else 0.0
         spec = args.bus or default_bus_spec()
         bus = open_bus(spec, **mode_options(spec, args.mode))
     except (ConfigError, BusError) as exc:
@@ -74,6 +76,7 @@ def main(argv: list[str] | None = None) -> int:
         bus.shutdown()
         return EXIT_BAD_INPUT
     node = FlightNode(db, bus, computer, Path(args.stats) if args.stats else None, rx_log)
+    node.lockstep_spin_s = spin_s
     node.install_signal_handlers()
     # Everything built so far (the DBC, the strategies) lives for the whole run: keep it out
     # of the cyclic garbage collector's passes, which otherwise walk it inside cycles.

@@ -64,6 +64,9 @@ TORQUE_DIM = 3
 WRENCH_DIM = 6
 ZERO3 = (0.0, 0.0, 0.0)
 MAX_THR_STATUS = 16  # THR_STATUS carries thrusters 0..15
+STATUS_CMD = tuple(f"Cmd_T{k:02d}" for k in range(MAX_THR_STATUS))  # its signal names
+STATUS_OPEN = tuple(f"Open_T{k:02d}" for k in range(MAX_THR_STATUS))
+STATUS_CURRENT = tuple(f"Current_T{k:02d}" for k in range(MAX_THR_STATUS))
 DEFAULT_NAV_TIMEOUT_NS = 300_000_000  # 3 NAV_POS periods of 100 ms
 # realtime: the cycle 2 ms after the bench's control instant (its samples of that instant
 # have arrived; lockstep models the same answer 1 ms after SYNC)
@@ -211,9 +214,9 @@ class FlightComputer:
         if self.thruster_fdir is None:
             return
         n = min(len(self.modulators), MAX_THR_STATUS)
-        cmd = np.array([bool(signals.get(f"Cmd_T{k:02d}", 0)) for k in range(n)])
-        opened = np.array([bool(signals.get(f"Open_T{k:02d}", 0)) for k in range(n)])
-        current = np.array([bool(signals.get(f"Current_T{k:02d}", 0)) for k in range(n)])
+        cmd = np.array([bool(signals.get(STATUS_CMD[k], 0)) for k in range(n)])
+        opened = np.array([bool(signals.get(STATUS_OPEN[k], 0)) for k in range(n)])
+        current = np.array([bool(signals.get(STATUS_CURRENT[k], 0)) for k in range(n)])
         self.thruster_fdir.on_valve_status(t_ns, cmd, opened, current)
 
     # --- restart ------------------------------------------------------------------------

@@ -36,6 +36,7 @@ import can
 import numpy as np
 from cantools.database.can import Database
 
+from dbc.bus import recv_spinning, send_frames
 from dbc.codec import Decoded, Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 from flight_sw.clock import MonotonicClock
@@ -55,6 +56,9 @@ CYCLE_MODULUS = 256
 STATUS_CYCLE_MODULUS = 65536
 OVERRUN_MAX = 255
 ON_TIME_LSB_S = 1e-4
+MAX_CMD_FRAMES = 4  # THR_CMD_0..3 in the DBC
+CMD_FRAMES = tuple(f"THR_CMD_{f}" for f in range(MAX_CMD_FRAMES))
+ON_TIME_SIGNALS = tuple(f"OnTime_T{k:02d}" for k in range(MAX_CMD_FRAMES * THRUSTERS_PER_CMD_FRAME))
 # A full-period pulse is sent this much longer, to bridge command-arrival jitter (see
 # ``send_commands``); far below the DBC's 102.3 ms and the bench's valve watchdog.
 FULL_ON_OVERLAP_S = 0.005
@@ -153,6 +157,7 @@ class FlightNode:
         self._stop = False
         self._waiting = False  # blocked in the bus receive: a stop signal may interrupt
         self.lockstep_silence_heartbeat_s = LOCKSTEP_SILENCE_HEARTBEAT_S
+        self.lockstep_spin_s = 0.0  # lockstep: poll this long before blocking (dbc.bus)
         self._last_sync: int | None = None
         self._pending_seen: set[str] = set()
         self._sync_cycle = -1
@@ -164,6 +169,8 @@ class FlightNode:
         self._bench_time_ns: int | None = None  # newest BENCH_STATUS SimTime
         self._realtime = False
         self._time_aligned = False
+        # lockstep: the frames of the cycle being computed, sent together at its end
+        self._held: list[tuple[str, can.Message]] | None = None
 
     # -- signals -----------------------------------------------------------------
     def install_signal_handlers(self) -> None:
@@ -202,14 +209,26 @@ class FlightNode:
         try:
             if self._stop:
                 raise StopRequested(0)
-            return self.bus.recv(timeout=timeout_s)
+            spin_s = 0.0 if self._realtime else self.lockstep_spin_s
+            return recv_spinning(self.bus, timeout_s, spin_s)
         finally:
             self._waiting = False
 
     # -- transmit ----------------------------------------------------------------
     def _send(self, name: str, signals: dict[str, float | int]) -> None:
-        self.bus.send(self.encoder.message(name, signals))
+        msg = self.encoder.message(name, signals)
+        if self._held is not None:  # a lockstep cycle: sent with the others at its end
+            self._held.append((name, msg))
+            return
+        self.bus.send(msg)
         self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
+
+    def _send_held(self) -> None:
+        """The cycle's frames, in the order encoded, as one burst (see dbc.bus.send_frames)."""
+        held = self._held or []
+        send_frames(self.bus, [msg for _name, msg in held])
+        for name, _msg in held:
+            self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
 
     def _status_signals(self, cycle: int) -> dict[str, float]:
         """FSW_STATUS content: mode, counters, FDIR flags, the allocation's saturation/residual."""
@@ -277,13 +296,25 @@ class FlightNode:
                 on = min(max(res.on_time_s[k] if k < self.n_thr else 0.0, 0.0), max_on)
                 if on >= max_on:
                     on = max_on + FULL_ON_OVERLAP_S
-                sig[f"OnTime_T{k:02d}"] = round(on / ON_TIME_LSB_S) * ON_TIME_LSB_S
-            self._send(f"THR_CMD_{f}", sig)
+                sig[ON_TIME_SIGNALS[k]] = round(on / ON_TIME_LSB_S) * ON_TIME_LSB_S
+            self._send(CMD_FRAMES[f], sig)
 
     def run_cycle(self, cycle: int, t_ns: int) -> None:
-        """One control cycle at ``t_ns`` and its frames (status first, commands last)."""
+        """One control cycle at ``t_ns`` and its frames (status first, commands last).
+
+        Lockstep: the frames go to the bus together once all are encoded (one burst on a
+        bus that takes bursts); realtime: each as soon as it is encoded.
+        """
         t0 = self.clock.now_ns()
-        self._cycle_frames(cycle, t_ns)
+        if self._realtime:
+            self._cycle_frames(cycle, t_ns)
+        else:
+            self._held = []
+            try:
+                self._cycle_frames(cycle, t_ns)
+                self._send_held()
+            finally:
+                self._held = None
         self.stats.cycle_ns.append(self.clock.now_ns() - t0)
 
     def _cycle_frames(self, cycle: int, t_ns: int) -> None:

@@ -2,7 +2,8 @@
 
 Two buses A and B opened on the same channel through :func:`dbc.bus.open_bus` (like
 python-can's back2back tests): frames sent by A arrive at B unchanged and in order, B's
-frames arrive at A, and ``recv`` honours its timeout. Run for ``virtual`` and ``hilbus``
+frames arrive at A, ``send_frames`` (one burst where the bus takes bursts) delivers like single sends, and
+``recv`` and ``recv_spinning`` honour their timeouts. Run for ``virtual`` and ``hilbus``
 always, and for ``socketcan:vcan0`` where the kernel has it. Plus :class:`dbc.bus.BusSpec`
 parsing and :func:`dbc.bus.default_bus_spec`.
 """
@@ -24,15 +25,21 @@ import can
 import pytest
 
 from dbc.bus import (
+    LOCKSTEP_SPIN_ENV,
+    LOCKSTEP_SPIN_MIN_CPUS,
+    LOCKSTEP_SPIN_S,
     REALTIME_MEMBER_STALL_S,
     SOCKETCAN_RCVBUF_BYTES,
     BusSpec,
     default_bus_spec,
     enlarge_receive_buffer,
+    lockstep_spin_s,
     mode_options,
     open_bus,
+    recv_spinning,
+    send_frames,
 )
-from dbc.errors import BusError
+from dbc.errors import BusError, ConfigError
 
 DEADLINE_S = 30.0
 TIMEOUT_SLACK_S = 0.5
@@ -196,6 +203,55 @@ def test_recv_timeout_semantics(pair: tuple[can.BusABC, can.BusABC, Kind]) -> No
     m = b.recv(timeout=DEADLINE_S)
     assert m is not None and m.arbitration_id == 0x1D0001
     assert time.monotonic() - t0 < TIMEOUT_SLACK_S
+
+
+def test_send_frames_arrive_like_single_sends(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
+    """send_frames: the same frames, unchanged and in order, as sending them one by one."""
+    a, b, kind = pair
+    sent = _frames(kind, 0x1E0000)[:40]
+    got: list[can.Message] = []
+    send_frames(a, sent)
+    deadline = time.monotonic() + DEADLINE_S
+    wanted = {_key(m) for m in sent}
+    while len(got) < len(sent) and (left := deadline - time.monotonic()) > 0:
+        m = b.recv(timeout=left)
+        if m is not None and _key(m) in wanted:  # vcan0 may carry other traffic
+            got.append(m)
+    assert [_key(m) for m in got] == [_key(m) for m in sent]
+    send_frames(a, [])  # nothing to send: nothing sent, no error
+
+
+def test_recv_spinning_timeout_semantics(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
+    """recv_spinning returns a waiting frame at once and otherwise gives up at its timeout,
+    whether the polling phase is shorter or longer than the timeout."""
+    a, b, kind = pair
+    while b.recv(timeout=0) is not None:  # vcan0 may carry other traffic
+        pass
+    a.send(can.Message(arbitration_id=0x1F0001, data=b"\x02"))
+    t0 = time.monotonic()
+    m = recv_spinning(b, DEADLINE_S, LOCKSTEP_SPIN_S)
+    assert m is not None and m.arbitration_id == 0x1F0001
+    assert time.monotonic() - t0 < TIMEOUT_SLACK_S
+    if kind.interface != "socketcan":  # a shared vcan0 may not stay quiet
+        for spin_s in (0.0, 0.05, 1.0):
+            t0 = time.monotonic()
+            assert recv_spinning(b, 0.2, spin_s) is None
+            assert 0.2 <= time.monotonic() - t0 < 0.2 + TIMEOUT_SLACK_S, spin_s
+
+
+def test_lockstep_spin_default_and_environment() -> None:
+    """Polling by default on enough CPUs, none on fewer; the environment variable wins."""
+    assert lockstep_spin_s(LOCKSTEP_SPIN_MIN_CPUS, {}) == LOCKSTEP_SPIN_S
+    assert lockstep_spin_s(LOCKSTEP_SPIN_MIN_CPUS - 1, {}) == 0.0
+    assert lockstep_spin_s(1, {LOCKSTEP_SPIN_ENV: "0.002"}) == 0.002
+    assert lockstep_spin_s(64, {LOCKSTEP_SPIN_ENV: "0"}) == 0.0
+
+
+@pytest.mark.parametrize("bad", ["fast", "-1", "nan", "inf", ""])
+def test_lockstep_spin_bad_environment_value_names_it(bad: str) -> None:
+    """A bad THRUSTER_HIL_LOCKSTEP_SPIN_S raises ConfigError naming the variable and value."""
+    with pytest.raises(ConfigError, match=rf"{LOCKSTEP_SPIN_ENV} = '{bad}'"):
+        lockstep_spin_s(2, {LOCKSTEP_SPIN_ENV: bad})
 
 
 # ---------------------------------------------------------------- bus specs

@@ -28,6 +28,7 @@ import pytest
 
 from dbc.errors import BusError
 from dbc.hilbus import (
+    BURST_MAX_RECORDS,
     HEADER,
     HilBus,
     HilMessage,
@@ -219,6 +220,78 @@ def test_burst_is_ordered_and_complete(pair: tuple[HilBus, HilBus]) -> None:
     got = collector.result()
     assert [int.from_bytes(m.data, "little") for m in got] == list(range(BURST_N))
     assert b.recv(timeout=0) is None
+
+
+def test_send_burst_arrives_as_single_frames_in_order(pair: tuple[HilBus, HilBus]) -> None:
+    """send_burst: every kind of frame arrives unchanged, in order, one recv() each."""
+    a, b = pair
+    sent = _variety()
+    a.send_burst(sent)
+    got = _recv_n(b, len(sent))
+    assert [_key(m) for m in got] == [_key(m) for m in sent]
+    assert len({m.timestamp for m in got}) == 1  # one datagram: one arrival time
+    assert b.recv(timeout=0) is None and b.malformed_records == 0
+
+
+def test_send_burst_is_one_datagram_per_member_up_to_the_record_limit(
+    pair: tuple[HilBus, HilBus],
+) -> None:
+    """A burst of N frames queues ceil(N / BURST_MAX_RECORDS) datagrams at the receiver."""
+    a, b = pair
+    n = 2 * BURST_MAX_RECORDS + 1
+    a.send_burst([can.Message(arbitration_id=i, data=i.to_bytes(2, "little")) for i in range(n)])
+    datagrams = []
+    while True:  # read b's socket raw: what the sender queued, datagram by datagram
+        try:
+            datagrams.append(b._sock.recv(1 << 16, socket.MSG_DONTWAIT))
+        except BlockingIOError:
+            break
+    assert len(datagrams) == 3
+    assert [len(d) for d in datagrams] == [(HEADER.size + 2) * BURST_MAX_RECORDS] * 2 + [
+        HEADER.size + 2]
+
+
+def test_burst_then_single_frames_keep_their_order(pair: tuple[HilBus, HilBus]) -> None:
+    """Frames sent after a burst are received after all of the burst's frames."""
+    a, b = pair
+    a.send_burst([can.Message(arbitration_id=i) for i in range(5)])
+    a.send(can.Message(arbitration_id=5))
+    a.send_burst([can.Message(arbitration_id=i) for i in (6, 7)])
+    assert [m.arbitration_id for m in _recv_n(b, 8)] == list(range(8))
+
+
+def test_burst_with_receive_own_messages(channel: str) -> None:
+    """A burst is delivered to its sender too, frame by frame, marked as sent (is_rx False)."""
+    with HilBus(channel, receive_own_messages=True) as a, HilBus(channel) as b:
+        a.send_burst([can.Message(arbitration_id=i) for i in range(3)])
+        own = _recv_n(a, 3)
+        assert [m.arbitration_id for m in own] == [0, 1, 2]
+        assert not any(m.is_rx for m in own)
+        assert [m.arbitration_id for m in _recv_n(b, 3)] == [0, 1, 2]
+
+
+def test_fileno_stays_readable_while_a_burst_is_being_read(pair: tuple[HilBus, HilBus]) -> None:
+    """After the first frame of a burst is read, fileno() still reads as readable."""
+    a, b = pair
+    fd = b.fileno()
+    a.send_burst([can.Message(arbitration_id=i) for i in range(3)])
+    for i in range(3):
+        r, _, _ = select.select([fd], [], [], DEADLINE_S)
+        assert r == [fd], f"fileno not readable before frame {i}"
+        assert _recv_n(b, 1)[0].arbitration_id == i
+    assert b.recv(timeout=0) is None
+
+
+def test_burst_with_trailing_garbage_keeps_whole_records(pair: tuple[HilBus, HilBus]) -> None:
+    """A datagram of records plus a torn one: the whole records arrive, the rest is counted."""
+    _a, b = pair
+    rec = HEADER.pack(0.0, 0x12, 0, 2, 2) + b"\x01\x02"
+    with socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as raw:
+        raw.sendto(rec + rec + rec[:5], os.fspath(b.path))
+    got = _recv_n(b, 2)
+    assert [bytes(m.data) for m in got] == [b"\x01\x02", b"\x01\x02"]
+    assert b.recv(timeout=0) is None
+    assert b.malformed_records == 1
 
 
 def test_bursters_in_one_thread_each_do_not_deadlock(pair: tuple[HilBus, HilBus]) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import random
 from typing import Any
 
+import cantools
 import numpy as np
 import pytest
 from cantools.database.can import Database, Message
@@ -111,3 +112,30 @@ def test_out_of_range_missing_and_non_numeric_values_name_the_signal(db: Databas
                        (None, "None")):
         with pytest.raises(IcdError, match=rf"IMU_RATE: RateX = {shown}"):
             layout.pack({**good, "RateX": bad})
+
+
+MIXED_DBC = """VERSION ""
+BS_:
+BU_: A
+BO_ 256 MIXED: 8 A
+ SG_ Big : 7|12@0- (0.5,1) [-1000|1000] "" A
+ SG_ Little : 16|10@1+ (1,0) [0|1023] "" A
+ SG_ Flt : 32|32@1- (1,0) [-1e6|1e6] "" A
+SIG_VALTYPE_ 256 Flt : 1;
+"""
+
+
+def test_big_endian_and_float_signals_equal_cantools() -> None:
+    """A message with Motorola and IEEE-float signals (the general path) packs and unpacks
+    exactly as cantools does."""
+    m = cantools.database.load_string(MIXED_DBC, database_format="dbc").get_message_by_name(
+        "MIXED")
+    layout = FrameLayout(m)
+    rng = random.Random(10)
+    for _ in range(CASES_PER_MESSAGE):
+        values = {"Big": rng.randint(-2048, 2047) * 0.5 + 1, "Little": rng.randint(0, 1023),
+                  "Flt": rng.uniform(-1e6, 1e6)}
+        values["Big"] = min(max(values["Big"], -1000.0), 1000.0)
+        data = m.encode(values, scaling=True, strict=False)
+        assert bytes(layout.pack(values)) == data
+        assert layout.unpack(data) == m.decode(data, decode_choices=False, scaling=True)

@@ -82,12 +82,13 @@ class Bench:
         return got
 
 
-@pytest.fixture
-def setup() -> Iterator[tuple[FlightNode, Bench]]:
-    """A FlightNode running its lockstep loop on a private virtual bus, and a bench."""
+@pytest.fixture(params=["virtual", "hilbus"])
+def setup(request: pytest.FixtureRequest, runtime: Path) -> Iterator[tuple[FlightNode, Bench]]:
+    """A FlightNode running its lockstep loop on a private bus (python-can's in-process
+    virtual bus, and hilbus, where a cycle's frames go out as one burst), and a bench."""
     channel = f"fsw-{uuid.uuid4().hex[:8]}"
-    fsw_bus = can.Bus(interface="virtual", channel=channel)
-    bench_bus = can.Bus(interface="virtual", channel=channel)
+    fsw_bus = can.Bus(interface=request.param, channel=channel)
+    bench_bus = can.Bus(interface=request.param, channel=channel)
     db = load_database()
     fc = build_computer(
         load_scenario(QUICKSTART).fsw_config(),
@@ -127,6 +128,24 @@ def test_each_sync_is_answered_for_its_cycle(setup: tuple[FlightNode, Bench]) ->
         # within the period, or a full-on pulse stretched to overlap the next command
         assert all(0.0 <= x <= PERIOD_S or x == pytest.approx(FULL_ON_S) for x in on)
     assert node.fc.mode == Mode.NOMINAL
+
+
+def test_a_cycle_sends_status_first_and_commands_last(setup: tuple[FlightNode, Bench]) -> None:
+    """Cycle 0 (a status cycle): FSW_STATUS, FSW_ATT_EST, FSW_FDIR, then THR_CMD_0 and _1, and
+    the node counts each frame it sent."""
+    node, bench = setup
+    bench.sensors()
+    bench.send("SYNC", {"Cycle": 0, "SimTime": 0.0})
+    names = []
+    while "THR_CMD_1" not in names:
+        msg = bench.bus.recv(RECV_TIMEOUT_S)
+        assert msg is not None, "no answer to SYNC(0)"
+        d = bench.chk.check(msg)
+        if d is not None:
+            names.append(d.name)
+    assert names == ["FSW_STATUS", "FSW_ATT_EST", "FSW_FDIR", "THR_CMD_0", "THR_CMD_1"]
+    assert node.stats.sent["THR_CMD_0"] == node.stats.sent["THR_CMD_1"] == 1
+    assert node.stats.sent["FSW_STATUS"] == 2  # the boot heartbeat, then cycle 0's
 
 
 def test_stale_sync_is_rejected_and_counted(setup: tuple[FlightNode, Bench]) -> None:
