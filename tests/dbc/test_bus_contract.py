@@ -2,9 +2,10 @@
 
 Two buses A and B opened on the same channel through :func:`dbc.bus.open_bus` (like
 python-can's back2back tests): frames sent by A arrive at B unchanged and in order, B's
-frames arrive at A, ``send_frames`` (one burst where the bus takes bursts) delivers like single sends, and
-``recv`` and ``recv_spinning`` honour their timeouts. Run for ``virtual`` and ``hilbus``
-always, and for ``socketcan:vcan0`` where the kernel has it. Plus :class:`dbc.bus.BusSpec`
+frames arrive at A, ``send_frames`` (one burst where the bus takes bursts) delivers like
+single sends, and ``recv`` and ``recv_spinning`` honour their timeouts. Run for ``virtual``
+and ``hilbus`` always, and for ``socketcan:vcan0`` where the kernel has it. Plus
+:class:`dbc.bus.BusSpec`
 parsing and :func:`dbc.bus.default_bus_spec`.
 """
 
