@@ -5,8 +5,7 @@ python-can's back2back tests): frames sent by A arrive at B unchanged and in ord
 frames arrive at A, ``send_frames`` (one burst where the bus takes bursts) delivers like
 single sends, and ``recv`` and ``recv_spinning`` honour their timeouts. Run for ``virtual``
 and ``hilbus`` always, and for ``socketcan:vcan0`` where the kernel has it. Plus
-:class:`dbc.bus.BusSpec`
-parsing and :func:`dbc.bus.default_bus_spec`.
+:class:`dbc.bus.BusSpec` parsing and :func:`dbc.bus.default_bus_spec`.
 """
 
 from __future__ import annotations
