@@ -1,14 +1,17 @@
 """Build hook: compiles the hot-path modules to C extensions with mypyc.
 
 What and why
-    The modules in :data:`COMPILED` (bench: rigid-body RK4, valves and thruster set, CAN
-    bit timing, plant, sensors, the bench loop, recorder; dbc: E2E CRC, signal packing;
-    flight_sw: quaternions, dual quaternions, NFTSM, PWPF) are plain, fully typed Python.
-    mypyc (mypy's compiler, https://mypyc.readthedocs.io) turns each into a C extension
-    that Python imports instead of the ``.py`` beside it; the arithmetic is the same IEEE double
-    arithmetic in the same order (no fused multiply-add on the x86-64 baseline), so
-    results are bit-identical (``tests/test_compiled.py`` checks compiled against the
-    source on known inputs). ``benchmarks/compiled_speedup.py`` measures the gain.
+    The modules in :data:`COMPILED` (bench: rigid-body RK4 (also with HCW translation and
+    environment wrenches), disturbance and gravity-gradient models, valves and thruster
+    set, CAN bit timing, plant, sensors, the bench loop, recorder; dbc: E2E CRC, signal
+    packing, frame encoding and checks; flight_sw: quaternions, dual quaternions, NFTSM,
+    PWPF, the allocators' dense box-QP and least-squares kernels) are plain, fully typed
+    Python. mypyc (mypy's compiler, https://mypyc.readthedocs.io) turns each into a C
+    extension that Python imports instead of the ``.py`` beside it; the arithmetic is the
+    same IEEE double arithmetic in the same order (no fused multiply-add on the x86-64
+    baseline), so results are bit-identical (``tests/test_compiled.py`` checks compiled
+    against the source on known inputs). ``benchmarks/compiled_speedup.py`` measures the
+    gain.
 
 Pure-Python install
     ``THRUSTER_HIL_PURE=1 pip install -e .`` builds nothing: every module runs from its
@@ -42,6 +45,11 @@ from setuptools import setup
 
 COMPILED = [
     "bench/dynamics/rigid_body.py",
+    "bench/dynamics/stepper.py",
+    "bench/dynamics/translation.py",
+    "bench/dynamics/hcw.py",
+    "bench/environment/disturbance.py",
+    "bench/environment/gravity_gradient.py",
     "bench/valves/valve.py",
     "bench/valves/thruster_set.py",
     "bench/bus/timing.py",
@@ -58,6 +66,7 @@ COMPILED = [
     "flight_sw/dual_quaternion.py",
     "flight_sw/modulation/pwpf.py",
     "flight_sw/control/nftsm_dq.py",
+    "flight_sw/allocation/dense.py",
 ]
 PURE_ENV = "THRUSTER_HIL_PURE"
 PACKAGES = ("bench", "dbc", "flight_sw")

@@ -30,6 +30,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from mypy_extensions import mypyc_attr
+
 from bench.dynamics.rigid_body import Vec3
 from dbc.errors import ConfigError
 
@@ -47,6 +49,7 @@ def mean_motion_rad_s(orbit_radius_m: float, mu_m3_s2: float = MU_EARTH_M3_S2) -
     return math.sqrt(mu_m3_s2 / orbit_radius_m**3)
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class HcwParams:
     """Circular orbit of the leader: radius [m] and gravitational parameter [m³/s²]."""

@@ -282,7 +282,7 @@ def state_v_N(state: State) -> Vec3:
 
 
 # --- equations of motion -------------------------------------------------------------------
-def _rates(
+def rates_of(
     q0: float,
     q1: float,
     q2: float,
@@ -338,7 +338,7 @@ def derivative(state: State, force_B_N: Vec3, torque_B_Nm: Vec3, mp: MassPropert
         torque_B_Nm[1],
         torque_B_Nm[2],
     )
-    d = _rates(
+    d = rates_of(
         q0,
         q1,
         q2,

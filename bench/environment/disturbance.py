@@ -22,6 +22,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from mypy_extensions import mypyc_attr
+
 from bench.dynamics.rigid_body import (
     ZERO_VEC3,
     MassProperties,
@@ -51,6 +53,7 @@ def _vec3(value: object, source: str, key: str) -> Vec3:
     return (float(seq[0]), float(seq[1]), float(seq[2]))
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class Sinusoid:
     """a sin(ω t + φ): amplitude 3-vector (unit of the quantity), ω [rad/s], φ [rad]."""
@@ -68,6 +71,7 @@ class Sinusoid:
             object.__setattr__(self, key, float(getattr(self, key)))
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class DisturbanceParams:
     """Constant force [N] / torque [N·m] plus sinusoids, and the force's frame."""
@@ -102,14 +106,29 @@ class DisturbanceParams:
         )
 
 
+SinusoidTerm = tuple[float, float, float, float, float]
+"""A sinusoid as plain floats: (ω [rad/s], φ [rad], amplitude x, y, z)."""
+
+
+def sinusoid_terms(sinusoids: Sequence[Sinusoid]) -> list[SinusoidTerm]:
+    """The sinusoids as plain float tuples (what the hot path reads)."""
+    return [(s.omega_rad_s, s.phase_rad, s.amplitude[0], s.amplitude[1], s.amplitude[2])
+            for s in sinusoids]
+
+
 def sinusoid_sum(t_s: float, constant: Vec3, sinusoids: Sequence[Sinusoid]) -> Vec3:
     """c + Σ a sin(ω t + φ) at ``t_s`` [s]."""
+    return terms_sum(t_s, constant, sinusoid_terms(sinusoids))
+
+
+def terms_sum(t_s: float, constant: Vec3, terms: list[SinusoidTerm]) -> Vec3:
+    """:func:`sinusoid_sum` of sinusoids given as :func:`sinusoid_terms`."""
     x, y, z = constant
-    for s in sinusoids:
-        k = math.sin(s.omega_rad_s * t_s + s.phase_rad)
-        x += s.amplitude[0] * k
-        y += s.amplitude[1] * k
-        z += s.amplitude[2] * k
+    for omega, phase, ax, ay, az in terms:
+        k = math.sin(omega * t_s + phase)
+        x += ax * k
+        y += ay * k
+        z += az * k
     return (x, y, z)
 
 
@@ -139,17 +158,19 @@ class Disturbance:
         self.params = params
         self.translation: TranslationModel = translation or InertialTranslation()
         self._nav = params.force_frame == "nav"
+        self._force0: Vec3 = params.force_N
+        self._torque0: Vec3 = params.torque_Nm
+        self._force_terms = sinusoid_terms(params.force_sinusoids)
+        self._torque_terms = sinusoid_terms(params.torque_sinusoids)
 
     def force_nav_or_body_N(self, t_s: float) -> Vec3:
         """The force as given, in its own frame (body or navigation) [N]."""
-        p = self.params
-        return sinusoid_sum(t_s, p.force_N, p.force_sinusoids)
+        return terms_sum(t_s, self._force0, self._force_terms)
 
     def wrench_B(self, t_s: float, q_BN: Quat, mp: MassProperties) -> Wrench:
         """Disturbance force [N] and torque [N·m] in body axes at ``t_s``."""
-        p = self.params
         f = self.force_nav_or_body_N(t_s)
         if self._nav:
             f = rotate_N_to_B(q_BN, self.translation.nav_to_inertial(t_s, f))
-        tq = sinusoid_sum(t_s, p.torque_Nm, p.torque_sinusoids)
+        tq = terms_sum(t_s, self._torque0, self._torque_terms)
         return (f[0], f[1], f[2], tq[0], tq[1], tq[2])

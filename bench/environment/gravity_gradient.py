@@ -26,6 +26,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from mypy_extensions import mypyc_attr
+
 from bench.dynamics.hcw import MU_EARTH_M3_S2, SEED000_ORBIT_RADIUS_M, mean_motion_rad_s
 from bench.dynamics.rigid_body import MassProperties, Quat, Vec3, Wrench, rotate_N_to_B
 from dbc.errors import ConfigError
@@ -34,6 +36,7 @@ GG_FACTOR = 3.0
 """The 3 of 3μ/R³."""
 
 
+@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
 @dataclass(frozen=True)
 class GravityGradientParams:
     """Circular reference orbit: radius [m] and gravitational parameter [m³/s²]."""

@@ -75,7 +75,9 @@ import osqp
 import scipy.sparse as sp
 
 from dbc.errors import ConfigError
+from flight_sw.allocation import dense
 from flight_sw.allocation.base import AllocationResult
+from flight_sw.allocation.dense import AT_LOWER, AT_UPPER, FREE  # active-set states of box_qp
 from flight_sw.allocation.osqp_lean import LeanOsqp
 
 MAX_DEMAND_DIM = 6
@@ -99,8 +101,8 @@ OSQP_ADAPTIVE_RHO_INTERVAL = 25
 OSQP_TIME_LIMIT_OFF_S = 1e10
 # BoundedQpAllocator only needs OSQP's active set (box_qp then solves exactly): loose
 # tolerances, no polishing, and a low iteration bound keep its worst case short.
-OSQP_STAGE_ONE_EPS = 1e-7
-OSQP_STAGE_ONE_MAX_ITER = 150
+OSQP_STAGE_ONE_EPS = 1e-4
+OSQP_STAGE_ONE_MAX_ITER = 60
 
 _SOURCE = "BoundedQpParams"
 
@@ -238,8 +240,21 @@ def refine_on_active_set(
 
     ``b_w = W^½ B_a`` and ``d_w = W^½ d``; bounds within ACTIVE_RTOL·(hi − lo) of ``t`` are
     held, the free thrusters get ``(b_w,F)⁺ (d_w − b_w,A t_A)``; free ones that leave the box
-    are then held at the violated bound and the step repeated (at most n times).
+    are then held at the violated bound and the step repeated (at most n times). Solved by
+    :func:`flight_sw.allocation.dense.refine_active_set` (normal equations, Cholesky) when
+    every step is well conditioned, here with LAPACK's lstsq otherwise.
     """
+    done, fast = dense.refine_active_set(b_w.tolist(), d_w.tolist(), t.tolist(), lo.tolist(),
+                                         hi.tolist(), ACTIVE_RTOL)
+    if done:  # the Cholesky form answered (flight_sw/allocation/dense.py)
+        return None if fast is None else np.array(fast)
+    return refine_lstsq(b_w, d_w, t, lo, hi)
+
+
+def refine_lstsq(
+    b_w: np.ndarray, d_w: np.ndarray, t: np.ndarray, lo: np.ndarray, hi: np.ndarray
+) -> np.ndarray | None:
+    """:func:`refine_on_active_set` with LAPACK's least-norm lstsq at every step."""
     tol = ACTIVE_RTOL * (hi - lo)
     at_lo = t <= lo + tol
     at_hi = (t >= hi - tol) & ~at_lo
@@ -279,8 +294,6 @@ NEWTON_SHRINK = 0.5
 # Bisect geometrically when the bracket spans more than this ratio (root near 0).
 GEOMETRIC_BISECTION_RATIO = 4.0
 
-# Active-set state of box_qp per variable.
-AT_LOWER, FREE, AT_UPPER = -1, 0, 1
 
 
 def _free_solve(
@@ -312,6 +325,7 @@ def box_qp(
     hi: np.ndarray,
     state: np.ndarray,
     definite: bool,
+    m_list: list[list[float]] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``argmin_{lo ≤ x ≤ hi} ½ xᵀMx − cᵀx`` (dense, exact up to round-off) and its active set.
 
@@ -322,8 +336,34 @@ def box_qp(
     rounds (Hintermüller, Ito & Kunisch 2003, SIAM J. Optim. 13(3) 865–888), which end when
     the set repeats (then the KKT conditions hold); should they not settle within
     :data:`MAX_PDAS_ITER` rounds, the primal active-set method (Nocedal & Wright 2006,
-    alg. 16.3), finite for a convex QP, finishes from the clipped iterate.
+    alg. 16.3), finite for a convex QP, finishes from the clipped iterate. The rounds run in
+    :func:`flight_sw.allocation.dense.box_qp_pdas` (Cholesky on Python floats) when ``M`` is
+    definite, here on numpy otherwise or when a free-set matrix is singular; ``m_list``:
+    ``M`` as nested lists, when the caller keeps it (``M.tolist()`` otherwise).
     """
+    if definite:  # the Cholesky form (flight_sw/allocation/dense.py) unless M_FF is singular
+        fast = dense.box_qp_pdas(m_mat.tolist() if m_list is None else m_list, c.tolist(),
+                                 lo.tolist(), hi.tolist(), state.tolist(), MAX_PDAS_ITER,
+                                 BOX_XTOL)
+        if fast is not None:
+            x_f, st_f, settled = fast
+            x = np.array(x_f)
+            if settled:
+                return x, np.array(st_f, dtype=np.int8)
+            return _primal_active_set(m_mat, c, lo, hi, np.minimum(np.maximum(x, lo), hi),
+                                      definite)
+    return box_qp_numpy(m_mat, c, lo, hi, state, definite)
+
+
+def box_qp_numpy(
+    m_mat: np.ndarray,
+    c: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    state: np.ndarray,
+    definite: bool,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`box_qp` with numpy and LAPACK throughout (least-norm on singular free sets)."""
     fixed = lo >= hi
     st = np.where(fixed, AT_LOWER, state).astype(np.int8)
     xtol = BOX_XTOL * (hi - lo)
@@ -520,6 +560,7 @@ class BoundedQpAllocator:
             )
             self._osqp = LeanOsqp(problem)
             self._m_mat = self._b_w.T @ self._b_w + eps * np.eye(k)
+            self._m_list = self._m_mat.tolist()
             self._definite = eps > 0.0
         # the previous call's exact active set: the warm start of box_qp when OSQP stopped
         # at its iteration cap without converging (its guess is then often far off)
@@ -573,7 +614,8 @@ class BoundedQpAllocator:
         if not converged and self._state_prev is not None and self._params.warm_start:
             state = self._state_prev
         t_qp, final_state = box_qp(
-            self._m_mat, self._b_w.T @ d_w, self._lo_a, self._hi_a, state, self._definite
+            self._m_mat, self._b_w.T @ d_w, self._lo_a, self._hi_a, state, self._definite,
+            self._m_list,
         )
         self._state_prev = final_state
         refined = refine_on_active_set(self._b_w, d_w, t_qp, self._lo_a, self._hi_a)
