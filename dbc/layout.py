@@ -162,16 +162,8 @@ class FrameLayout:
         if self._fields:
             return self._unpack_fields(data)
         unpacked = {**self._big.unpack(data), **self._little.unpack(data[::-1])}
-        out: dict[str, Any] = {}
-        for name, mode, scale, offset, conv in self._dec:
-            raw = unpacked[name]
-            if mode == IDENTITY:
-                out[name] = raw
-            elif mode == LINEAR:
-                out[name] = raw * scale + offset
-            else:
-                out[name] = conv.raw_to_scaled(raw, False)
-        return out
+        return {name: _physical(unpacked[name], mode, scale, offset, conv)
+                for name, mode, scale, offset, conv in self._dec}
 
     def _unpack_fields(self, data: bytes | bytearray) -> dict[str, Any]:
         """``unpack`` for a message of little-endian integer fields only."""
@@ -182,10 +174,14 @@ class FrameLayout:
             sign = self._sign_bits[i]
             if raw & sign:
                 raw -= sign << 1
-            if mode == IDENTITY:
-                out[name] = raw
-            elif mode == LINEAR:
-                out[name] = raw * scale + offset
-            else:
-                out[name] = conv.raw_to_scaled(raw, False)
+            out[name] = _physical(raw, mode, scale, offset, conv)
         return out
+
+
+def _physical(raw: Any, mode: int, scale: Any, offset: Any, conv: Any) -> Any:
+    """A raw signal value in physical units, of cantools' type (ints stay ints unscaled)."""
+    if mode == IDENTITY:
+        return raw
+    if mode == LINEAR:
+        return raw * scale + offset
+    return conv.raw_to_scaled(raw, False)

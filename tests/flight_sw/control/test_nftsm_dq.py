@@ -233,3 +233,30 @@ def test_auxiliary_surface_matches_the_vectorised_equations() -> None:
         want = _auxiliary_surface_vectorised(xi, xi_dot, a1, a2, 0.6, delta)
         np.testing.assert_allclose(got[0], want[0], rtol=AUX_RTOL, atol=0.0)
         np.testing.assert_allclose(got[1], want[1], rtol=AUX_RTOL, atol=0.0)
+
+
+N_LAW_CASES = 300
+LAW_RTOL = 1e-9  # the float form against the array form: round-off of different orders
+SEED_LAW = 12
+
+
+@pytest.mark.parametrize("anti_unwinding", [False, True])
+@pytest.mark.parametrize("n", [0.0, PAPER_MEAN_MOTION_RAD_S])
+def test_float_law_equals_the_array_reference(anti_unwinding: bool, n: float) -> None:
+    """wrench_B (floats) equals wrench_B_reference (the paper's terms as arrays) on random
+    poses, twists and references, with and without orbit terms and anti-unwinding."""
+    rng = np.random.default_rng(SEED_LAW)
+    law = NftsmDq(NftsmDqParams(mean_motion_rad_s=n, anti_unwinding=anti_unwinding,
+                                inertia_B_kgm2=(18.0, 19.0, 24.0), max_force_N=300.0))
+    law.set_inertia_B_kgm2(np.array([[18.0, 0.4, 0.1], [0.4, 19.0, -0.3], [0.1, -0.3, 24.0]]))
+    for _ in range(N_LAW_CASES):
+        q = quat.normalise(rng.normal(size=4))
+        # anti-unwinding: errors well inside its singular angle (module docstring)
+        q_ref = (quat.multiply(q, quat.from_rotation_vector(rng.normal(size=3) * 0.4))
+                 if anti_unwinding else quat.normalise(rng.normal(size=4)))
+        args = (0, q, rng.normal(size=3) * 0.1, rng.normal(size=3) * 10.0,
+                rng.normal(size=3) * 0.1, q_ref, rng.normal(size=3) * 0.01,
+                rng.normal(size=3), rng.normal(size=3) * 0.01)
+        ref = law.wrench_B_reference(*args)
+        np.testing.assert_allclose(law.wrench_B(*args), ref, rtol=0.0,
+                                   atol=LAW_RTOL * max(1.0, float(np.abs(ref).max())))
