@@ -128,3 +128,24 @@ def test_pwpf_on_times_match_source() -> None:
         assert mod_c.on_time_s(k * period_ns, u, period_s) == mod_s.on_time_s(
             k * period_ns, u, period_s
         )
+
+
+def test_rls_kernel_matches_source() -> None:
+    """Compiled RLS window equations and steps equal the interpreted ones exactly."""
+    compiled = importlib.import_module("flight_sw.estimation.rls_kernel")
+    source = _source_twin("flight_sw.estimation.rls_kernel")
+    rng = np.random.default_rng(SEED)
+    window = 5
+    for _ in range(CASES):
+        h_s = rng.uniform(0.019, 0.021, size=window).tolist()
+        omega = rng.normal(size=(window + 1, 3)).tolist()
+        gyro = [compiled.gyroscopic(w) for w in omega]
+        assert gyro == [source.gyroscopic(w) for w in omega]
+        tau = rng.normal(size=(window, 3)).tolist()
+        phi, y = compiled.window_equation(h_s, omega[0], omega[-1], gyro, tau)
+        assert (phi, y) == source.window_equation(h_s, omega[0], omega[-1], gyro, tau)
+        a = rng.normal(size=(6, 6))
+        p = (a @ a.T).tolist()
+        theta = rng.normal(size=6).tolist()
+        args = (p, theta, np.eye(6).tolist(), phi, y, 0.99, 10.0)
+        assert compiled.rls_step(*args) == source.rls_step(*args)

@@ -36,10 +36,10 @@ scaled down whenever its trace exceeds that of ``P_0`` (constant-trace bound).
 
 Excitation: the identifier also keeps the discounted information matrix
 ``R_k = λ R_{k−1} + Φ_kᵀ Φ_k`` [(rad/s²)²]; :meth:`RlsInertiaIdentifier.update` returns
-the estimate only while ``λ_min(R_k) ≥ min_information`` and the estimate is positive
-definite, else None (so a caller keeps its last good inertia). With a torque-equation
-residual of standard deviation σ_T [N m], the estimate's standard deviation is about
-``σ_T / sqrt(λ_min(R))`` [kg m²]. Steps whose regressor is weaker than
+the estimate only while ``λ_min(R_k) > min_information`` and the estimate is positive
+definite (both tested by Cholesky), else None (so a caller keeps its last good inertia).
+With a torque-equation residual of standard deviation σ_T [N m], the estimate's standard
+deviation is about ``σ_T / sqrt(λ_min(R))`` [kg m²]. Steps whose regressor is weaker than
 ``min_regressor_norm`` (Frobenius norm) are skipped entirely (no forgetting either).
 
 Inputs: ``update(t_ns, omega_BN_B, torque_B_Nm)`` once per control cycle: time [ns], the
@@ -59,6 +59,11 @@ Source: seed 001 ("Attitude control and structure robust control allocation for 
 spacecraft"), §2: Euler
 equation (2), the RLS equations with forgetting factor and Remark 1; the regressor
 parametrisation of the momentum-based identification the seed cites as [7].
+
+Computation: the per-cycle arithmetic (regressor, window sums, RLS step, gates) runs on
+floats in :mod:`flight_sw.estimation.rls_kernel` (compiled); the numpy forms here
+(:func:`window_equation_reference`, :func:`rls_step_reference`) are its reference, tested
+equal to round-off.
 """
 
 from __future__ import annotations
@@ -71,6 +76,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
+from flight_sw.estimation import rls_kernel as kernel
 from flight_sw.quaternion import skew
 
 N_PARAMS = 6  # unique entries of a symmetric 3×3 tensor
@@ -135,33 +141,74 @@ def euler_regressor(omega_prev_B: np.ndarray, omega_B: np.ndarray, dt_s: float) 
     return momentum_regressor((w1 - w0) / dt_s) + TRAPEZOID_WEIGHT * gyro
 
 
-def _gyroscopic(omega_B: np.ndarray) -> np.ndarray:
-    """``[ω×] Ω(ω)`` (3×6): the gyroscopic term of Euler's equation, linear in θ."""
-    return skew(omega_B) @ momentum_regressor(omega_B)
-
-
-def _window_equation(hist: list[_Sample]) -> tuple[np.ndarray, np.ndarray]:
-    """``(Φ, y)`` of Euler's equation integrated over the samples of ``hist`` (docstring)."""
-    if len(hist) == 2:  # one period: the exact single-step form
-        a, b = hist
-        return euler_regressor(a.omega_B, b.omega_B, (b.t_ns - a.t_ns) / NS_PER_S), b.torque_B_Nm
-    h = np.diff([x.t_ns for x in hist]) / NS_PER_S  # period lengths [s]
-    g = np.stack([x.gyro for x in hist])  # (N+1)×3×6
-    tau = np.stack([x.torque_B_Nm for x in hist[1:]])  # torque of each period
+def window_equation_reference(
+    t_ns: Sequence[int], omega_B: Sequence[np.ndarray], torque_B_Nm: Sequence[np.ndarray]
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(Φ, y)`` over the samples given, in numpy (the reference form of the kernel's
+    :func:`~flight_sw.estimation.rls_kernel.window_equation`); ``torque_B_Nm[0]`` unused."""
+    if len(t_ns) == 2:  # one period: the single-step form
+        return euler_regressor(omega_B[0], omega_B[1], (t_ns[1] - t_ns[0]) / NS_PER_S), \
+            np.asarray(torque_B_Nm[1], dtype=float)
+    h = np.diff(np.asarray(t_ns, dtype=float)) / NS_PER_S  # period lengths [s]
+    g = np.stack([skew(w) @ momentum_regressor(w) for w in omega_B])  # (N+1)×3×6
+    tau = np.stack([np.asarray(x, dtype=float) for x in torque_B_Nm[1:]])
     total_s = float(h.sum())
     gyro = TRAPEZOID_WEIGHT * np.einsum("k,kij->ij", h, g[:-1] + g[1:])
-    phi = momentum_regressor((hist[-1].omega_B - hist[0].omega_B) / total_s) + gyro / total_s
-    return phi, h @ tau / total_s
+    dw = (np.asarray(omega_B[-1], dtype=float) - np.asarray(omega_B[0], dtype=float)) / total_s
+    return momentum_regressor(dw) + gyro / total_s, h @ tau / total_s
 
 
-@dataclass(frozen=True)
-class _Sample:
-    """One update's data: time [ns], rate [rad/s], torque of the period before [N m]."""
+def rls_step_reference(
+    p: np.ndarray, theta: np.ndarray, info: np.ndarray, phi: np.ndarray, y: np.ndarray,
+    lam: float, trace_cap: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One RLS step in numpy (seed 001 §2), the reference form of the kernel's
+    :func:`~flight_sw.estimation.rls_kernel.rls_step`: ``(P_k, θ_k, R_k)``."""
+    p_phi_t = p @ phi.T
+    s = lam * np.eye(N_AXES) + phi @ p_phi_t
+    gain = np.linalg.solve(s, p_phi_t.T).T  # P Φᵀ S⁻¹ (S symmetric)
+    theta_new = theta + gain @ (y - phi @ theta)
+    p_new = (p - gain @ phi @ p) / lam
+    p_new = 0.5 * (p_new + p_new.T)
+    trace = float(np.trace(p_new))
+    if trace > trace_cap:
+        p_new *= trace_cap / trace
+    return p_new, theta_new, lam * info + phi.T @ phi
 
-    t_ns: int
-    omega_B: np.ndarray
-    torque_B_Nm: np.ndarray
-    gyro: np.ndarray  # [ω×] Ω(ω), computed once per sample
+
+class _Window:
+    """The last N + 1 samples as the kernel takes them: rates [rad/s] and their
+    ``[ω×]Ω(ω)``, and the N periods' lengths [s] and mean torques [N m]."""
+
+    def __init__(self, n_periods: int) -> None:
+        self.n_periods = n_periods
+        self.t_last_ns: int | None = None
+        self.omega_B: list[list[float]] = []
+        self.gyro: list[list[float]] = []
+        self.h_s: list[float] = []
+        self.torque_B_Nm: list[list[float]] = []
+
+    @property
+    def full(self) -> bool:
+        """Whether N periods are held."""
+        return len(self.h_s) == self.n_periods
+
+    def clear(self) -> None:
+        """Forget every sample (the differencing restarts)."""
+        self.t_last_ns = None
+        for samples in (self.omega_B, self.gyro, self.h_s, self.torque_B_Nm):
+            samples.clear()
+
+    def push(self, t_ns: int, omega_B: list[float], torque_B_Nm: list[float]) -> None:
+        """Add the sample at ``t_ns`` with the torque of the period it ends; drop the oldest."""
+        if self.t_last_ns is not None:
+            self.h_s.append((t_ns - self.t_last_ns) / NS_PER_S)
+            self.torque_B_Nm.append(torque_B_Nm)
+        self.t_last_ns = t_ns
+        self.omega_B.append(omega_B)
+        self.gyro.append(kernel.gyroscopic(omega_B))
+        if len(self.h_s) > self.n_periods:
+            del self.omega_B[0], self.gyro[0], self.h_s[0], self.torque_B_Nm[0]
 
 
 def _inertia_tuple(value: object) -> tuple[tuple[float, float, float], ...]:
@@ -227,14 +274,19 @@ class RlsInertiaParams:
 
 
 class RlsInertiaIdentifier:
-    """RLS identifier of the inertia tensor (implements ``InertiaIdentifier``)."""
+    """RLS identifier of the inertia tensor (implements ``InertiaIdentifier``).
+
+    The per-cycle arithmetic runs in :mod:`flight_sw.estimation.rls_kernel` on floats;
+    the numpy forms above (:func:`window_equation_reference`, :func:`rls_step_reference`)
+    define it and take the step when the kernel cannot (an ill-conditioned ``S``).
+    """
 
     def __init__(self, params: RlsInertiaParams) -> None:
         self._params = params
-        self._theta = inertia_params(np.array(params.inertia_guess_B_kgm2))
-        self._p = np.eye(N_PARAMS) * params.initial_covariance
-        self._info = np.zeros((N_PARAMS, N_PARAMS))
-        self._history: list[_Sample] = []
+        self._theta: list[float] = inertia_params(np.array(params.inertia_guess_B_kgm2)).tolist()
+        self._p = _scaled_identity(params.initial_covariance)
+        self._info = _scaled_identity(0.0)
+        self._window = _Window(params.window_cycles)
         self._n_updates = 0
 
     @property
@@ -245,17 +297,17 @@ class RlsInertiaIdentifier:
     @property
     def inertia_B_kgm2(self) -> np.ndarray:
         """The current estimate (3×3, symmetric) [kg m²], whether excited or not."""
-        return inertia_matrix(self._theta)
+        return inertia_matrix(np.array(self._theta))
 
     @property
     def covariance(self) -> np.ndarray:
         """A copy of P (6×6) [(kg m²)²] in the order of θ."""
-        return self._p.copy()
+        return np.array(self._p)
 
     @property
     def min_information(self) -> float:
         """λ_min of the discounted information matrix R [(rad/s²)²]."""
-        return float(np.linalg.eigvalsh(self._info)[0])
+        return float(np.linalg.eigvalsh(np.array(self._info))[0])
 
     @property
     def n_updates(self) -> int:
@@ -272,10 +324,10 @@ class RlsInertiaIdentifier:
         """
         if inertia_guess_B_kgm2 is not None:
             guess = np.array(_inertia_tuple(inertia_guess_B_kgm2))
-            self._theta = inertia_params(guess)
-        self._p = np.eye(N_PARAMS) * self._params.initial_covariance
-        self._info = np.zeros((N_PARAMS, N_PARAMS))
-        self._history = []
+            self._theta = inertia_params(guess).tolist()
+        self._p = _scaled_identity(self._params.initial_covariance)
+        self._info = _scaled_identity(0.0)
+        self._window.clear()
         self._n_updates = 0
 
     def update(
@@ -287,52 +339,59 @@ class RlsInertiaIdentifier:
         definite, else None. A non-finite input, a non-increasing time or a gap above
         ``max_gap_s`` drops the pair of samples (the differencing restarts).
         """
-        w = np.array(omega_BN_B, dtype=float).reshape(N_AXES)
-        tau = np.array(torque_B_Nm, dtype=float).reshape(N_AXES)
-        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(tau))):
-            self._history = []
+        w = _vector3(omega_BN_B)
+        tau = _vector3(torque_B_Nm)
+        win = self._window
+        if not all(math.isfinite(x) for x in w + tau):
+            win.clear()
             return self._output()
-        hist = self._history
-        if hist:
-            dt_s = (t_ns - hist[-1].t_ns) / NS_PER_S
+        if win.t_last_ns is not None:
+            dt_s = (t_ns - win.t_last_ns) / NS_PER_S
             if not 0.0 < dt_s <= self._params.max_gap_s:
-                hist.clear()
-        hist.append(_Sample(t_ns, w, tau, _gyroscopic(w)))
-        n = self._params.window_cycles
-        if len(hist) > n + 1:
-            del hist[0]
-        if len(hist) < n + 1:
+                win.clear()
+        win.push(t_ns, w, tau)
+        if not win.full:
             return self._output()
-        phi, y = _window_equation(hist)
-        if float(np.linalg.norm(phi)) < self._params.min_regressor_norm:
+        phi, y = kernel.window_equation(
+            win.h_s, win.omega_B[0], win.omega_B[-1], win.gyro, win.torque_B_Nm
+        )
+        if math.sqrt(sum(v * v for row in phi for v in row)) < self._params.min_regressor_norm:
             return self._output()
         self._step(phi, y)
         return self._output()
 
-    def _step(self, phi: np.ndarray, y: np.ndarray) -> None:
+    def _step(self, phi: list[list[float]], y: list[float]) -> None:
         """One RLS step (seed 001 §2) with the constant-trace bound on P."""
         lam = self._params.forgetting_factor
-        p = self._p
-        p_phi_t = p @ phi.T
-        s = lam * np.eye(N_AXES) + phi @ p_phi_t
-        gain = np.linalg.solve(s, p_phi_t.T).T  # P Φᵀ S⁻¹ (S symmetric)
-        self._theta = self._theta + gain @ (y - phi @ self._theta)
-        p = (p - gain @ phi @ p) / lam
-        p = 0.5 * (p + p.T)
         trace_cap = N_PARAMS * self._params.initial_covariance
-        trace = float(np.trace(p))
-        if trace > trace_cap:
-            p *= trace_cap / trace
-        self._p = p
-        self._info = lam * self._info + phi.T @ phi
+        out = kernel.rls_step(self._p, self._theta, self._info, phi, y, lam, trace_cap)
+        if out is None:  # S not numerically positive definite: LAPACK's LU solve
+            p, theta, info = rls_step_reference(
+                np.array(self._p), np.array(self._theta), np.array(self._info),
+                np.array(phi), np.array(y), lam, trace_cap,
+            )
+            out = (p.tolist(), theta.tolist(), info.tolist())
+        self._p, self._theta, self._info = out
         self._n_updates += 1
 
     def _output(self) -> np.ndarray | None:
+        """The estimate while ``λ_min(R) > min_information`` and it is positive definite."""
         if self._n_updates == 0:
             return None
-        if float(np.linalg.eigvalsh(self._info)[0]) < self._params.min_information:
+        if not kernel.exceeds(self._info, self._params.min_information):
             return None
-        j = inertia_matrix(self._theta)
-        if not float(np.linalg.eigvalsh(j)[0]) > 0.0:
+        j11, j12, j13, j22, j23, j33 = self._theta
+        j = [[j11, j12, j13], [j12, j22, j23], [j13, j23, j33]]
+        if not kernel.exceeds(j, 0.0):
             return None
-        return j
+        return np.array(j)
+
+
+def _scaled_identity(value: float) -> list[list[float]]:
+    """``value · I6`` as a list of rows."""
+    return [[value if r == c else 0.0 for c in range(N_PARAMS)] for r in range(N_PARAMS)]
+
+
+def _vector3(value: np.ndarray) -> list[float]:
+    """A 3-vector as a list of floats."""
+    return [float(x) for x in np.asarray(value, dtype=float).reshape(N_AXES).tolist()]

@@ -1,0 +1,235 @@
+"""Dense kernels of the RLS inertia identifier, on Python floats (compiled with mypyc).
+
+What it does: the per-cycle arithmetic of :mod:`flight_sw.estimation.rls_inertia` written
+out for its fixed sizes (3 axes, 6 parameters), where numpy's per-call overhead (~1-10 µs a
+call, some thirty calls a cycle, a 51-sample stack with a 50-cycle window) is most of the
+time and the arithmetic itself is about two thousand flops:
+
+- :func:`gyroscopic`: ``[ω×] Ω(ω)`` (3×6, flat), the gyroscopic term of Euler's equation
+  (seed 001 eq. (2)) linear in ``θ = (J11, J12, J13, J22, J23, J33)``.
+- :func:`window_equation`: ``(Φ, y)`` of Euler's equation integrated over a window of
+  samples by the trapezoidal rule (the equation of the identifier's module docstring).
+- :func:`rls_step`: one RLS step with forgetting factor (seed 001 §2), the symmetrisation
+  and the constant-trace bound on ``P``, and the discounted information ``R``.
+- :func:`exceeds`: whether ``A − m I`` is positive definite (``λ_min(A) > m``), by
+  Cholesky, for the identifier's excitation and positive-definiteness gates.
+
+In and out: plain lists, matrices as lists of rows, float64. Rates [rad/s], torques [N m],
+times [s], ``θ`` [kg m²], ``P`` [(kg m²)²], ``R`` [(rad/s²)²]. :func:`rls_step` returns None
+when the 3×3 innovation matrix ``S = λ I + Φ P Φᵀ`` (positive definite in exact arithmetic,
+``S ≥ λ I``) has a Cholesky pivot at or below :data:`S_PIVOT_RTOL` times its diagonal entry:
+the caller then takes the step with numpy/LAPACK (its reference form, which defines the
+result in that case).
+
+Assumptions: finite inputs, ``P`` and ``R`` symmetric, ``0 < λ ≤ 1``.
+
+Source: seed 001 ("Attitude control and structure robust control allocation for combined
+spacecraft"), §2: Euler equation (2) and the three RLS equations with forgetting factor.
+"""
+
+from __future__ import annotations
+
+import math
+
+N_AXES = 3
+N_PARAMS = 6
+TRAPEZOID_WEIGHT = 0.5
+# A Cholesky pivot of S below this × its diagonal entry: S is not numerically positive
+# definite (only when P Φᵀ is ~1e16 × λ); numpy's LU solve takes over.
+S_PIVOT_RTOL = 1e-14
+
+Vector = list[float]
+Matrix = list[list[float]]
+
+
+def momentum_regressor(w: Vector) -> Matrix:
+    """``Ω(ω)`` (3×6) with ``J ω = Ω(ω) θ``."""
+    w1, w2, w3 = w[0], w[1], w[2]
+    return [
+        [w1, w2, w3, 0.0, 0.0, 0.0],
+        [0.0, w1, 0.0, w2, w3, 0.0],
+        [0.0, 0.0, w1, 0.0, w2, w3],
+    ]
+
+
+def gyroscopic(w: Vector) -> Vector:
+    """``[ω×] Ω(ω)`` (3×6) written out, flat in row order (18 entries)."""
+    w1, w2, w3 = w[0], w[1], w[2]
+    return [
+        0.0, -w1 * w3, w1 * w2, -w2 * w3, w2 * w2 - w3 * w3, w2 * w3,
+        w1 * w3, w2 * w3, w3 * w3 - w1 * w1, 0.0, -w1 * w2, -w1 * w3,
+        -w1 * w2, w1 * w1 - w2 * w2, -w2 * w3, w1 * w2, w1 * w3, 0.0,
+    ]
+
+
+def window_equation(
+    h_s: Vector, omega_first: Vector, omega_last: Vector, gyro: list[Vector], torque: Matrix
+) -> tuple[Matrix, Vector]:
+    """``(Φ, y)`` of Euler's equation integrated over ``len(h_s)`` periods.
+
+    ``h_s[k]`` is the length of period k [s] (> 0), ``gyro`` the N + 1 samples'
+    ``[ω×]Ω(ω)`` (flat, as :func:`gyroscopic`), ``torque`` the N periods' mean torques
+    [N m]. With ``T = Σ h_k``:
+    ``Φ = Ω((ω_last − ω_first)/T) + (1/T) Σ_k ½ h_k (G_k + G_{k+1})``,
+    ``y = (1/T) Σ_k h_k τ_k``; the trapezoid sum is taken per sample, with the weight
+    ``½ (h_{k−1} + h_k)`` of the two periods it bounds.
+    """
+    n = len(h_s)
+    total_s = 0.0
+    for k in range(n):
+        total_s += h_s[k]
+    inv_t = 1.0 / total_s
+    weight = [0.0] * (n + 1)
+    for k in range(n + 1):
+        weight[k] = TRAPEZOID_WEIGHT * ((h_s[k - 1] if k > 0 else 0.0) + (h_s[k] if k < n else 0.0))
+    dw = [(omega_last[i] - omega_first[i]) * inv_t for i in range(N_AXES)]
+    phi = momentum_regressor(dw)
+    for i in range(N_AXES):
+        p_i = phi[i]
+        for j in range(N_PARAMS):
+            e = i * N_PARAMS + j
+            s = 0.0
+            for k in range(n + 1):
+                s += weight[k] * gyro[k][e]
+            p_i[j] += s * inv_t
+    y = [0.0] * N_AXES
+    for i in range(N_AXES):
+        s = 0.0
+        for k in range(n):
+            s += h_s[k] * torque[k][i]
+        y[i] = s * inv_t
+    return phi, y
+
+
+def _cholesky(a: Matrix, shift: float, pivot_rtol: float) -> Matrix | None:
+    """Lower factor of ``A − shift·I``; None if a pivot is at or below ``pivot_rtol`` × its
+    diagonal entry of ``A − shift·I`` (or not a number)."""
+    n = len(a)
+    low: Matrix = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        a_i = a[i]
+        l_i = low[i]
+        for j in range(i + 1):
+            l_j = low[j]
+            s = a_i[j] - shift if i == j else a_i[j]
+            for k in range(j):
+                s -= l_i[k] * l_j[k]
+            if i == j:
+                if not s > pivot_rtol * (a_i[i] - shift):
+                    return None
+                l_i[i] = math.sqrt(s)
+            else:
+                l_i[j] = s / l_j[j]
+    return low
+
+
+def exceeds(a: Matrix, m: float) -> bool:
+    """Whether ``A − m I`` (A symmetric) is positive definite, i.e. ``λ_min(A) > m``."""
+    return _cholesky(a, m, 0.0) is not None
+
+
+def rls_step(
+    p: Matrix, theta: Vector, info: Matrix, phi: Matrix, y: Vector, lam: float,
+    trace_cap: float,
+) -> tuple[Matrix, Vector, Matrix] | None:
+    """One RLS step: ``(P_k, θ_k, R_k)``, or None if ``S`` is not numerically positive definite.
+
+    ``K = P Φᵀ S⁻¹`` with ``S = λ I3 + Φ P Φᵀ``, ``θ_k = θ + K (y − Φ θ)``,
+    ``P_k = sym((P − K Φ P)/λ)`` scaled to trace ``trace_cap`` if above it,
+    ``R_k = λ R + Φᵀ Φ``.
+    """
+    # P Φᵀ (6×3); P symmetric, so Φ P = (P Φᵀ)ᵀ
+    pf = [[0.0] * N_AXES for _ in range(N_PARAMS)]
+    for r in range(N_PARAMS):
+        p_r = p[r]
+        pf_r = pf[r]
+        for i in range(N_AXES):
+            f_i = phi[i]
+            s = 0.0
+            for c in range(N_PARAMS):
+                s += p_r[c] * f_i[c]
+            pf_r[i] = s
+    smat = [[0.0] * N_AXES for _ in range(N_AXES)]
+    for i in range(N_AXES):
+        f_i = phi[i]
+        for j in range(N_AXES):
+            s = lam if i == j else 0.0
+            for c in range(N_PARAMS):
+                s += f_i[c] * pf[c][j]
+            smat[i][j] = s
+    for i in range(N_AXES):  # symmetrise (Φ P Φᵀ is symmetric up to round-off)
+        for j in range(i):
+            v = 0.5 * (smat[i][j] + smat[j][i])
+            smat[i][j] = v
+            smat[j][i] = v
+    low = _cholesky(smat, 0.0, S_PIVOT_RTOL)
+    if low is None:
+        return None
+    # K = P Φᵀ S⁻¹: each row k_r solves S k_rᵀ = (P Φᵀ)_rᵀ
+    gain = [[0.0] * N_AXES for _ in range(N_PARAMS)]
+    for r in range(N_PARAMS):
+        z = [0.0] * N_AXES
+        b = pf[r]
+        for i in range(N_AXES):
+            s = b[i]
+            l_i = low[i]
+            for k in range(i):
+                s -= l_i[k] * z[k]
+            z[i] = s / l_i[i]
+        x = gain[r]
+        for i in range(N_AXES - 1, -1, -1):
+            s = z[i]
+            for k in range(i + 1, N_AXES):
+                s -= low[k][i] * x[k]
+            x[i] = s / low[i][i]
+    innovation = [0.0] * N_AXES
+    for i in range(N_AXES):
+        f_i = phi[i]
+        s = y[i]
+        for c in range(N_PARAMS):
+            s -= f_i[c] * theta[c]
+        innovation[i] = s
+    theta_new = [0.0] * N_PARAMS
+    for r in range(N_PARAMS):
+        k_r = gain[r]
+        s = theta[r]
+        for i in range(N_AXES):
+            s += k_r[i] * innovation[i]
+        theta_new[r] = s
+    # P_k = (P − K (P Φᵀ)ᵀ)/λ, symmetrised
+    p_new = [[0.0] * N_PARAMS for _ in range(N_PARAMS)]
+    inv_lam = 1.0 / lam
+    for r in range(N_PARAMS):
+        k_r = gain[r]
+        p_r = p[r]
+        q_r = p_new[r]
+        for c in range(N_PARAMS):
+            pf_c = pf[c]
+            s = p_r[c]
+            for i in range(N_AXES):
+                s -= k_r[i] * pf_c[i]
+            q_r[c] = s * inv_lam
+    trace = 0.0
+    for r in range(N_PARAMS):
+        q_r = p_new[r]
+        for c in range(r):
+            v = 0.5 * (q_r[c] + p_new[c][r])
+            q_r[c] = v
+            p_new[c][r] = v
+        trace += q_r[r]
+    if trace > trace_cap:
+        scale = trace_cap / trace
+        for r in range(N_PARAMS):
+            q_r = p_new[r]
+            for c in range(N_PARAMS):
+                q_r[c] *= scale
+    info_new = [[0.0] * N_PARAMS for _ in range(N_PARAMS)]
+    for r in range(N_PARAMS):
+        i_r = info[r]
+        o_r = info_new[r]
+        for c in range(N_PARAMS):
+            s = lam * i_r[c]
+            for i in range(N_AXES):
+                s += phi[i][r] * phi[i][c]
+            o_r[c] = s
+    return p_new, theta_new, info_new
