@@ -394,4 +394,5 @@ def _scaled_identity(value: float) -> list[list[float]]:
 
 def _vector3(value: np.ndarray) -> list[float]:
     """A 3-vector as a list of floats."""
-    return [float(x) for x in np.asarray(value, dtype=float).reshape(N_AXES).tolist()]
+    out: list[float] = np.asarray(value, dtype=float).reshape(N_AXES).tolist()
+    return out

@@ -14,6 +14,9 @@ time and the arithmetic itself is about two thousand flops:
 - :func:`exceeds`: whether ``A − m I`` is positive definite (``λ_min(A) > m``), by
   Cholesky, for the identifier's excitation and positive-definiteness gates.
 
+Cholesky factorisations and solves are :func:`flight_sw.allocation.dense.cholesky_solve`'s
+(the allocators' kernel, compiled in the same group).
+
 In and out: plain lists, matrices as lists of rows, float64. Rates [rad/s], torques [N m],
 times [s], ``θ`` [kg m²], ``P`` [(kg m²)²], ``R`` [(rad/s²)²]. :func:`rls_step` returns None
 when the 3×3 innovation matrix ``S = λ I + Φ P Φᵀ`` (positive definite in exact arithmetic,
@@ -29,7 +32,7 @@ spacecraft"), §2: Euler equation (2) and the three RLS equations with forgettin
 
 from __future__ import annotations
 
-import math
+from flight_sw.allocation.dense import cholesky_solve
 
 N_AXES = 3
 N_PARAMS = 6
@@ -101,31 +104,11 @@ def window_equation(
     return phi, y
 
 
-def _cholesky(a: Matrix, shift: float, pivot_rtol: float) -> Matrix | None:
-    """Lower factor of ``A − shift·I``; None if a pivot is at or below ``pivot_rtol`` × its
-    diagonal entry of ``A − shift·I`` (or not a number)."""
-    n = len(a)
-    low: Matrix = [[0.0] * n for _ in range(n)]
-    for i in range(n):
-        a_i = a[i]
-        l_i = low[i]
-        for j in range(i + 1):
-            l_j = low[j]
-            s = a_i[j] - shift if i == j else a_i[j]
-            for k in range(j):
-                s -= l_i[k] * l_j[k]
-            if i == j:
-                if not s > pivot_rtol * (a_i[i] - shift):
-                    return None
-                l_i[i] = math.sqrt(s)
-            else:
-                l_i[j] = s / l_j[j]
-    return low
-
-
 def exceeds(a: Matrix, m: float) -> bool:
     """Whether ``A − m I`` (A symmetric) is positive definite, i.e. ``λ_min(A) > m``."""
-    return _cholesky(a, m, 0.0) is not None
+    n = len(a)
+    shifted = [[a[i][j] - m if i == j else a[i][j] for j in range(n)] for i in range(n)]
+    return cholesky_solve(shifted, list(range(n)), [0.0] * n, 0.0) is not None
 
 
 def rls_step(
@@ -162,26 +145,14 @@ def rls_step(
             v = 0.5 * (smat[i][j] + smat[j][i])
             smat[i][j] = v
             smat[j][i] = v
-    low = _cholesky(smat, 0.0, S_PIVOT_RTOL)
-    if low is None:
-        return None
     # K = P Φᵀ S⁻¹: each row k_r solves S k_rᵀ = (P Φᵀ)_rᵀ
-    gain = [[0.0] * N_AXES for _ in range(N_PARAMS)]
+    axes = list(range(N_AXES))
+    gain: Matrix = []
     for r in range(N_PARAMS):
-        z = [0.0] * N_AXES
-        b = pf[r]
-        for i in range(N_AXES):
-            s = b[i]
-            l_i = low[i]
-            for k in range(i):
-                s -= l_i[k] * z[k]
-            z[i] = s / l_i[i]
-        x = gain[r]
-        for i in range(N_AXES - 1, -1, -1):
-            s = z[i]
-            for k in range(i + 1, N_AXES):
-                s -= low[k][i] * x[k]
-            x[i] = s / low[i][i]
+        row = cholesky_solve(smat, axes, pf[r], S_PIVOT_RTOL)
+        if row is None:
+            return None
+        gain.append(row)
     innovation = [0.0] * N_AXES
     for i in range(N_AXES):
         f_i = phi[i]
