@@ -13,7 +13,7 @@ stall; after ``SILENT_AFTER_STALLS`` stalls in a row the flight software is decl
 and the bench stops waiting (never hangs). In lockstep the samples of a control instant go
 to the bus together with its SYNC (one burst on hilbus), samples between control instants
 as soon as they are taken, and the run files' text is formatted while the flight software
-computes (bench/recorder.py, deferred writing). Realtime: the bench paces the plant to its own
+computes (bench/wire/recorder.py, deferred writing). Realtime: the bench paces the plant to its own
 monotonic clock, sends sensors when due and applies commands when they arrive; all
 latencies are measured. Valve watchdog: no valid command for ``WATCHDOG_PERIODS`` command
 periods closes every valve and records the event.
@@ -33,8 +33,15 @@ import numpy as np
 from cantools.database.can import Database
 from mypy_extensions import mypyc_attr
 
-from bench.bus.timing import INTERMISSION_BITS, BusArbiter, Delivery, frame_bits, wire_time_ns
-from bench.faults import (
+from bench.results.metrics import (
+    expectation,
+    latency_summary,
+    pointing_metrics,
+    settling_expectation,
+    settling_time_s,
+)
+from bench.scenario import Scenario
+from bench.station.faults import (
     BUS_KINDS,
     NO_FATE,
     REALTIME_BUS_KINDS,
@@ -43,17 +50,10 @@ from bench.faults import (
     fault_from_command,
     frame_fate,
 )
-from bench.metrics import (
-    expectation,
-    latency_summary,
-    pointing_metrics,
-    settling_expectation,
-    settling_time_s,
-)
-from bench.plant import STEP_NS, Plant
-from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
-from bench.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
-from bench.scenario import Scenario
+from bench.station.plant import STEP_NS, Plant
+from bench.station.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
+from bench.wire.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
+from bench.wire.timing import INTERMISSION_BITS, BusArbiter, Delivery, frame_bits, wire_time_ns
 from dbc.bus import recv_spinning, send_frames
 from dbc.codec import Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.errors import RunError
@@ -314,7 +314,7 @@ class BenchNode:
         if self.sc.reference.kind == KIND_STEP:
             err = quat_error_deg(q, self.sc.q_target_BN)
             rate_err = math.sqrt(s[4] ** 2 + s[5] ** 2 + s[6] ** 2) * RAD_DEG
-        else:  # a moving reference: errors w.r.t. q_RN(t), omega_RN(t) (bench/reference.py)
+        else:  # a moving reference: errors w.r.t. q_RN(t), omega_RN(t) (bench/station/reference.py)
             q_ref, w_ref = reference(self.sc.reference, t_ns / NS_PER_S)
             q_t = (s[0], s[1], s[2], s[3])
             err = attitude_error_deg(q_t, q_ref)

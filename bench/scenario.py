@@ -23,12 +23,12 @@ from typing import Any
 
 from cantools.database.can import Database
 
-from bench.dynamics.hcw import SEED000_ORBIT_RADIUS_M
-from bench.dynamics.rigid_body import MassProperties
-from bench.environment.disturbance import FORCE_FRAMES, DisturbanceParams, Sinusoid
-from bench.faults import FaultSpec, parse_faults
-from bench.reference import KIND_STEP, KINDS, ReferenceParams, reference
-from bench.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
+from bench.station.dynamics.hcw import SEED000_ORBIT_RADIUS_M
+from bench.station.dynamics.rigid_body import MassProperties
+from bench.station.environment.disturbance import FORCE_FRAMES, DisturbanceParams, Sinusoid
+from bench.station.faults import FaultSpec, parse_faults
+from bench.station.reference import KIND_STEP, KINDS, ReferenceParams, reference
+from bench.station.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
 from dbc import load_database
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps, bitrate_range_bps
 from dbc.errors import ConfigError
@@ -47,11 +47,11 @@ UNIT_NORM_TOL = 1e-6
 MODES = ("lockstep", "realtime")
 TRANSLATIONS = ("inertial", "hcw")
 FSW_TABLE = "flight_sw"  # the table passed through to the flight software
-"""[dynamics] translation: inertial (default) or HCW relative motion (bench.dynamics.hcw)."""
+"""[dynamics] translation: inertial (default) or HCW relative motion (station.dynamics.hcw)."""
 VALVE_MODELS = ("on_off", "throttled")
-"""[thrusters] valve_model: on_off (bench.valves.valve) or throttled (bench.valves.throttled)."""
+"""[thrusters] valve_model: on_off (station.valves.valve), throttled (station.valves.throttled)."""
 EVENT_KINDS = ("capture",)
-"""[[events]] kinds: capture (bench.dynamics.capture)."""
+"""[[events]] kinds: capture (bench.station.dynamics.capture)."""
 MAX_THRUSTERS = 16
 
 Vec3 = tuple[float, float, float]

@@ -20,7 +20,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from bench.valves.layouts import seed000_conventional_16, seed003_cascade_8
+from bench.station.valves.layouts import seed000_conventional_16, seed003_cascade_8
 from flight_sw.allocation.effectiveness import TORQUE_ROWS, effectiveness_matrix
 from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
 from flight_sw.allocation.qp_osqp import BoundedQpAllocator, BoundedQpParams

@@ -23,9 +23,15 @@ import sys
 import time
 from collections.abc import Callable
 
-from bench.dynamics.rigid_body import MassProperties, State, make_state, quat_normalize, rk4_step
-from bench.valves.thruster_set import ThrusterGeometry, ThrusterSet
-from bench.valves.valve import ValveParams
+from bench.station.dynamics.rigid_body import (
+    MassProperties,
+    State,
+    make_state,
+    quat_normalize,
+    rk4_step,
+)
+from bench.station.valves.thruster_set import ThrusterGeometry, ThrusterSet
+from bench.station.valves.valve import ValveParams
 
 DT_NS = 1_000_000
 DT_S = DT_NS * 1e-9

@@ -56,7 +56,7 @@ from typing import Any
 
 import numpy as np
 
-from bench.valves.layouts import seed001_table1_16
+from bench.station.valves.layouts import seed001_table1_16
 from flight_sw import mrp
 from flight_sw import quaternion as qt
 from flight_sw.allocation.effectiveness import TORQUE_ROWS, effectiveness_matrix

@@ -3,7 +3,7 @@
 For each bitrate (125 kbit/s, 500 kbit/s, 1 Mbit/s) and each periodic message of
 ``dbc/thruster_hil.dbc`` (``GenMsgCycleTime`` > 0, zero queuing jitter, deadline = period):
 worst-case frame length (bits), transmission time C and worst-case response time R (µs)
-from :func:`bench.bus.rta.response_times` (Davis, Burns, Bril, Lukkien 2007, revised
+from :func:`bench.operator.analysis.rta.response_times` (Davis, Burns, Bril, Lukkien 2007, revised
 analysis), the message's utilisation C/T, its level-m busy period, instances checked,
 and whether R <= deadline; per bitrate, the total bus utilisation.
 
@@ -19,7 +19,7 @@ from __future__ import annotations
 import json
 import sys
 
-from bench.bus.rta import messages_from_dbc, response_times
+from bench.operator.analysis.rta import messages_from_dbc, response_times
 from dbc import DBC_PATH, load_database
 
 BITRATES_BPS = (125_000, 500_000, 1_000_000)

@@ -7,7 +7,7 @@ SocketCAN, the reader's :func:`time.time` at receipt on the portable bus; second
 host's wall clock, microsecond resolution), ``id`` (arbitration ID) and ``counter`` (the
 E2E alive counter, ``-1`` for a frame too short to carry one). The bench's timing analysis
 pairs the rows with its own transmissions by ID and alive counter
-(:mod:`bench.analysis.reception`); the file is the only link, so neither side imports the
+(:mod:`bench.operator.analysis.reception`); the file is the only link, so neither side imports the
 other.
 
 Flushed by the caller once per control cycle, so a crash loses at most one cycle.

@@ -74,8 +74,8 @@ def test_compiled_module_is_built_and_fresh(path: str) -> None:
 
 def test_rk4_step_matches_source() -> None:
     """Compiled RK4 steps equal the interpreted ones exactly on random states."""
-    compiled = importlib.import_module("bench.dynamics.rigid_body")
-    source = _source_twin("bench.dynamics.rigid_body")
+    compiled = importlib.import_module("bench.station.dynamics.rigid_body")
+    source = _source_twin("bench.station.dynamics.rigid_body")
     rng = np.random.default_rng(SEED)
     j = np.diag([15.95, 72.19, 72.19]) + 0.5 * np.array([[0, 1, 0], [1, 0, 0], [0, 0, 0]])
     mp = compiled.MassProperties(87.0, tuple(tuple(float(x) for x in r) for r in j))
@@ -92,8 +92,8 @@ def test_rk4_step_matches_source() -> None:
 
 def test_frame_bits_and_crc_match_source() -> None:
     """Stuffed CAN frame lengths and E2E CRCs equal the interpreted ones on random frames."""
-    timing = importlib.import_module("bench.bus.timing")
-    timing_src = _source_twin("bench.bus.timing")
+    timing = importlib.import_module("bench.wire.timing")
+    timing_src = _source_twin("bench.wire.timing")
     e2e = importlib.import_module("dbc.e2e")
     e2e_src = _source_twin("dbc.e2e")
     rng = np.random.default_rng(SEED)

@@ -22,8 +22,8 @@ from pathlib import Path
 import can
 
 from bench.node import NS_PER_S, RT_FRAMES_PER_PASS, BenchNode, Clock
-from bench.plant import STEP_NS
 from bench.scenario import load_scenario
+from bench.station.plant import STEP_NS
 from dbc import load_database
 from dbc.bus import open_bus
 from dbc.codec import Encoder, cycle_time_ns

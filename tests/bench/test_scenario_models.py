@@ -10,10 +10,10 @@ from typing import Any
 
 import pytest
 
-from bench.dynamics.hcw import hcw_closed_form, mean_motion_rad_s
-from bench.dynamics.rigid_body import angular_momentum_N
-from bench.plant import NS_PER_S, STEP_NS, Plant
 from bench.scenario import load_scenario, parse_scenario
+from bench.station.dynamics.hcw import hcw_closed_form, mean_motion_rad_s
+from bench.station.dynamics.rigid_body import angular_momentum_N
+from bench.station.plant import NS_PER_S, STEP_NS, Plant
 from dbc.errors import ConfigError
 
 if sys.version_info >= (3, 11):

@@ -52,7 +52,7 @@ def run_cli(args: list[str], out: Path, runtime_dir: Path, timeout_s: float = RU
     """Run ``thruster-hil ARGS --out OUT`` with a private hilbus runtime directory."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
     p = subprocess.run(
-        [sys.executable, "-m", "bench.cli", *args, "--out", str(out)],
+        [sys.executable, "-m", "bench.operator.cli", *args, "--out", str(out)],
         capture_output=True,
         text=True,
         timeout=timeout_s,
@@ -97,7 +97,7 @@ def running(
     non-interactive shell, such as a CI runner's, inherits it ignored)."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
     p = subprocess.Popen(
-        [sys.executable, "-m", "bench.cli", *args, "--out", str(out)],
+        [sys.executable, "-m", "bench.operator.cli", *args, "--out", str(out)],
         cwd=REPO,
         env=env,
         stdout=subprocess.DEVNULL,
@@ -132,7 +132,7 @@ def flood(bus: str, runtime_dir: Path, frames: int, rate_hz: float) -> dict[str,
         [
             sys.executable,
             "-m",
-            "bench.flood",
+            "bench.operator.flood",
             "--bus",
             bus,
             "--frames",

@@ -9,7 +9,7 @@ from pathlib import Path
 import can
 import pytest
 
-from bench.bus.timing import failed_attempt_bits, wire_time_ns
+from bench.wire.timing import failed_attempt_bits, wire_time_ns
 from dbc import load_database
 from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
 

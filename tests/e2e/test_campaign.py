@@ -28,7 +28,7 @@ def test_every_single_thruster_failure_is_detected_isolated_and_survived(tmp_pat
         [
             sys.executable,
             "-m",
-            "bench.cli",
+            "bench.operator.cli",
             "campaign",
             str(SCENARIO),
             "--out",

@@ -81,7 +81,7 @@ def test_bench_alone_pairs_with_flight_software_started_by_hand(
         [
             sys.executable,
             "-m",
-            "bench.cli",
+            "bench.operator.cli",
             "bench",
             str(QUICKSTART),
             "--bus",

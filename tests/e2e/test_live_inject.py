@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from bench.inject import FaultCommand, cansend_string, inject
+from bench.operator.inject import FaultCommand, cansend_string, inject
 from dbc import load_database
 from dbc.codec import FrameChecker
 from dbc.errors import RefusedConfigError

@@ -22,7 +22,7 @@ from typing import Any
 
 import pytest
 
-from bench.analysis.reception import PAIRING_TOLERANCE_S
+from bench.operator.analysis.reception import PAIRING_TOLERANCE_S
 from tests.e2e.conftest import QUICKSTART, REPO, run_cli, unique_bus
 
 LOCKSTEP_S = "5"
@@ -63,7 +63,7 @@ def _timing(args: list[str], runtime_dir: Path | None = None) -> subprocess.Comp
     if runtime_dir is not None:
         env["XDG_RUNTIME_DIR"] = str(runtime_dir)
     return subprocess.run(
-        [sys.executable, "-m", "bench.cli", "timing", *args],
+        [sys.executable, "-m", "bench.operator.cli", "timing", *args],
         capture_output=True,
         text=True,
         timeout=PYTEST_TIMEOUT_S,
@@ -156,7 +156,7 @@ def _live_against_realtime_run(bus: str, tmp_path: Path, runtime_dir: Path) -> d
         [
             sys.executable,
             "-m",
-            "bench.cli",
+            "bench.operator.cli",
             "timing",
             "--live",
             "--bus",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bench.valves.layouts import seed000_conventional_16
+from bench.station.valves.layouts import seed000_conventional_16
 
 # Seed 003, Table 1.
 SEED003_INERTIA_KGM2 = (15.95, 72.19, 72.19)
@@ -68,7 +68,7 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20240531)
 
 
-# Seed 000: 16 thrusters, 5 N; the reconstructed four-quad layout (bench/valves/layouts.py)
+# Seed 000: 16 thrusters, 5 N; the reconstructed four-quad layout (bench/station/valves/layouts.py)
 # with the fdir_16thr scenario's dimensions; nominal mass and inertia.
 SEED000_THRUST_N = 5.0
 SEED000_ARM_R_M = 0.5

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
-from bench.valves.layouts import LAYOUTS, seed000_conventional_16
+from bench.station.valves.layouts import LAYOUTS, seed000_conventional_16
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 
 N_THRUSTERS = 16

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import pytest
 
-from bench.pytest_plugin import HilRun, HilRunner
+from bench.operator.pytest_plugin import HilRun, HilRunner
 
 QUICKSTART = "scenarios/quickstart.toml"  # relative to where pytest runs, or the rootdir
 DURATION_S = 5.0  # 250 control cycles

@@ -9,7 +9,7 @@ import pytest
 
 from flight_sw.allocation.effectiveness import TORQUE_ROWS, effectiveness_matrix
 
-# Seed 000 reconstructed four-quad layout (bench/valves/layouts.py, R = 0.5 m, L = 0.1 m).
+# Seed 000 reconstructed four-quad layout (bench/station/valves/layouts.py, R = 0.5 m, L = 0.1 m).
 SEED000_THRUST_N = 5.0
 SEED000_R_M = 0.5
 SEED000_L_M = 0.1

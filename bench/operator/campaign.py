@@ -1,0 +1,184 @@
+"""Single-failure campaign: every thruster stuck closed, then stuck open, one lockstep run each.
+
+``python -m bench.operator.campaign SCENARIO --out DIR [--fault-time S] [--jobs N] [--kinds ...]``
+(also ``thruster-hil campaign``). Each run is the scenario with one ``[[faults]]`` entry
+appended, started as its own ``thruster-hil run`` process on a private portable-bus channel,
+``--jobs`` at a time (with more processes than CPUs, their lockstep waits block at once
+instead of polling first: see dbc.bus). The flight software's FDIR report (FSW_FDIR, in each
+summary.json) gives detection and isolation. Out, in DIR: ``campaign.csv`` (one row per run:
+thruster, kind, detected, detection time after the fault, isolated thruster, isolation
+correct, expectations met, final attitude and position error, propellant), ``campaign.json``
+and ``campaign.png`` (detection time per thruster and kind), plus every run folder. Exit 0
+if every run detected and isolated its failure and met the scenario's expectations, 1 if
+not, 2 on bad input, 3 if a run could not complete.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import uuid
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+from bench.scenario import load_scenario
+from dbc.bus import LOCKSTEP_SPIN_ENV, available_cpus
+from dbc.errors import ConfigError, RunError
+
+KINDS = ("stuck_closed", "stuck_open")
+DEFAULT_FAULT_TIME_S = 10.0
+EXIT_BAD_INPUT, EXIT_RUN_ERROR = 2, 3  # as thruster-hil run's
+COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruster",
+           "isolation_correct", "expectations_met", "final_attitude_error_deg",
+           "final_position_error_m", "propellant_kg", "run_dir"]
+DPI = 110
+PROCESSES_PER_RUN = 2  # bench + flight software
+
+
+def _run_one(scenario: Path, fault: str, out: Path, xdg: Path, spin_off: bool) -> dict[str, Any]:
+    out.mkdir(parents=True, exist_ok=True)
+    text = scenario.read_text(encoding="utf-8").rstrip() + "\n" + fault
+    sc_file = out / "campaign_scenario.toml"
+    sc_file.write_text(text, encoding="utf-8")
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
+    if spin_off:  # more processes than CPUs: a polling wait would hold a CPU another needs
+        env.setdefault(LOCKSTEP_SPIN_ENV, "0")
+    p = subprocess.run(
+        [sys.executable, "-m", "bench.operator.cli", "run", str(sc_file), "--bus",
+         f"hilbus:c{uuid.uuid4().hex[:10]}", "--out", str(out / "run")],
+        env=env, capture_output=True, text=True, check=False,
+    )
+    summary = out / "run" / "summary.json"
+    if p.returncode == EXIT_BAD_INPUT or not summary.exists():
+        last = (p.stderr.strip().splitlines() or ["(no output)"])[-1]
+        raise RunError(f"campaign run {out.name} failed (exit {p.returncode}): {last}")
+    return json.loads(summary.read_text(encoding="utf-8"))
+
+
+def _row(k: int, kind: str, fault_t_s: float, s: dict[str, Any], run_dir: Path) -> dict[str, Any]:
+    fdir = s.get("fdir") or {}
+    iso = fdir.get("failed_thruster")
+    t_det = fdir.get("detection_time_s")
+    return {
+        "thruster": k, "kind": kind, "detected": iso is not None,
+        "detection_time_s": None if t_det is None else round(t_det - fault_t_s, 3),
+        "isolated_thruster": iso,
+        "isolation_correct": iso == k and fdir.get("failure_kind") == kind,
+        "expectations_met": bool(s.get("passed")),
+        "final_attitude_error_deg": s.get("final_attitude_error_deg"),
+        "final_position_error_m": s.get("final_position_error_m"),
+        "propellant_kg": s.get("propellant_kg"),
+        "run_dir": str(run_dir),
+    }
+
+
+def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
+                 kinds: tuple[str, ...] = KINDS) -> list[dict[str, Any]]:
+    """Run every single-thruster failure of ``kinds``; write the CSV, JSON and PNG."""
+    sc = load_scenario(scenario)
+    if not 0.0 <= fault_t_s < sc.duration_s:  # also NaN
+        raise ConfigError("command line", "--fault-time", fault_t_s,
+                          f"a time in [0, {sc.duration_s:g}) s (the scenario's duration)")
+    if jobs < 1:
+        raise ConfigError("command line", "--jobs", jobs, "at least 1")
+    n = len(sc.thrusters)
+    out.mkdir(parents=True, exist_ok=True)
+    cases = [(k, kind) for kind in kinds for k in range(n)]
+    spin_off = PROCESSES_PER_RUN * min(jobs, len(cases)) > available_cpus()
+    with tempfile.TemporaryDirectory(prefix="thil-campaign-") as tmp:
+        xdg = Path(tmp)
+        xdg.chmod(0o700)
+
+        def job(case: tuple[int, str]) -> dict[str, Any]:
+            k, kind = case
+            d = out / f"{kind}_T{k:02d}"
+            fault = f'\n[[faults]]\nt_s = {fault_t_s}\nkind = "{kind}"\nthruster = {k}\n'
+            return _row(k, kind, fault_t_s, _run_one(scenario, fault, d, xdg, spin_off),
+                        d / "run")
+
+        with ThreadPoolExecutor(max_workers=jobs) as pool:
+            futures = [pool.submit(job, case) for case in cases]
+            try:
+                rows = [fut.result() for fut in futures]
+            except BaseException:  # one run failed: do not start the others
+                for fut in futures:
+                    fut.cancel()
+                raise
+    with open(out / "campaign.csv", "w", newline="", encoding="utf-8") as f:
+        w = csv.DictWriter(f, fieldnames=COLUMNS)
+        w.writeheader()
+        w.writerows(rows)
+    (out / "campaign.json").write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+    _plot(rows, out / "campaign.png")
+    return rows
+
+
+def _plot(rows: list[dict[str, Any]], path: Path) -> None:
+    from bench.operator.plots import (
+        plt,  # matplotlib is loaded only when there is something to plot
+    )
+
+    fig, ax = plt.subplots(figsize=(9, 4))
+    width = 0.4
+    kinds = [k for k in KINDS if any(r["kind"] == k for r in rows)]
+    for i, kind in enumerate(kinds):
+        sel = [r for r in rows if r["kind"] == kind]
+        xs = [r["thruster"] + (i - 0.5) * width for r in sel]
+        ys = [r["detection_time_s"] if r["detection_time_s"] is not None else 0.0 for r in sel]
+        bars = ax.bar(xs, ys, width, label=kind)
+        for bar, r in zip(bars, sel, strict=True):
+            if not r["detected"] or not r["isolation_correct"]:
+                bar.set_hatch("//")
+                bar.set_edgecolor("red")
+    ax.set_xlabel("failed thruster")
+    ax.set_ylabel("detection time after the fault [s]")
+    ax.set_title("Single-failure campaign (hatched: not detected or wrongly isolated)")
+    ax.legend()
+    ax.grid(True, axis="y", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+
+
+def add_arguments(p: argparse.ArgumentParser, default_jobs: int) -> None:
+    """The campaign's options (shared with ``thruster-hil campaign``)."""
+    p.add_argument("scenario", help="scenario TOML file (its thrusters, duration, seed)")
+    p.add_argument("--out", required=True, help="folder for campaign.csv/.json/.png and runs")
+    p.add_argument("--fault-time", type=float, default=DEFAULT_FAULT_TIME_S,
+                   help=f"when each fault starts [s] (default {DEFAULT_FAULT_TIME_S:g})")
+    p.add_argument("--jobs", type=int, default=default_jobs,
+                   help=f"runs at a time (default {default_jobs})")
+    p.add_argument("--kinds", nargs="+", choices=KINDS, default=list(KINDS),
+                   help="failure kinds (default both)")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line; exit 0 if every run was detected, isolated and met its expectations."""
+    p = argparse.ArgumentParser(prog="thruster-hil campaign", description=__doc__.split("\n")[0])
+    add_arguments(p, default_jobs=max(1, (os.cpu_count() or 2) // 2))
+    args = p.parse_args(argv)
+    try:
+        rows = run_campaign(Path(args.scenario), Path(args.out), args.fault_time, args.jobs,
+                            tuple(args.kinds))
+    except ConfigError as exc:
+        print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RunError as exc:
+        print(f"thruster-hil campaign: run error: {exc}", file=sys.stderr)
+        return EXIT_RUN_ERROR
+    for r in rows:
+        print(f"T{r['thruster']:02d} {r['kind']:12s} detected={r['detected']!s:5} "
+              f"t={r['detection_time_s']} isolated={r['isolated_thruster']} "
+              f"ok={r['isolation_correct']} expectations={r['expectations_met']}")
+    ok = all(r["detected"] and r["isolation_correct"] and r["expectations_met"] for r in rows)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,374 @@
+"""``thruster-hil``: the bench operator's console.
+
+Subcommands: ``run SCENARIO`` (bench + flight software as two processes, lockstep or
+realtime), ``bench SCENARIO`` (the bench alone, for external flight software or hardware
+on the same bus), ``report RUN_DIR`` (redraw plots, print the summary), ``timing RUN_DIR``
+(per-message timing, chains, bus load, worst-case bounds; ``timing --live --bus SPEC``
+measures a running bus). Exit codes: 0 pass, 1 the run's expectations failed (``timing
+--strict``: a measured latency above its bound, or a message sent but never received), 2
+bad input (scenario, options), 3 run error, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from dbc.bus import BusSpec, default_bus_spec
+from dbc.errors import BusError, ConfigError, IcdError, RunError
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
+BAR_WIDTH = 30
+
+
+def _progress_printer() -> Any:
+    tty = sys.stderr.isatty()
+    last = [-1.0]
+
+    def show(t_s: float, total_s: float) -> None:
+        frac = min(1.0, t_s / total_s) if total_s > 0 else 1.0
+        if tty:
+            n = int(frac * BAR_WIDTH)
+            sys.stderr.write(f"\r[{'#' * n}{'.' * (BAR_WIDTH - n)}] {t_s:7.2f}/{total_s:.2f} s sim")
+            sys.stderr.flush()
+        elif frac - last[0] >= 0.1 or frac >= 1.0:
+            last[0] = frac
+            sys.stderr.write(f"progress {frac * 100:5.1f} % ({t_s:.1f}/{total_s:.1f} s sim)\n")
+
+    return show
+
+
+def _fmt(x: Any, spec: str = ".4f", none: str = "n/a") -> str:
+    return none if x is None else format(x, spec)
+
+
+def _settling_text(settling: float | None) -> str:
+    if settling is None:
+        return "not settled"
+    return f"{settling:.2f} s" + (" (never left the band)" if settling == 0.0 else "")
+
+
+def _print_summary(s: dict[str, Any], out: Path) -> None:
+    lat = s["latency_us"]["sensor_to_command"]
+    dm = s.get("deadline_misses") or {}
+    settling = s["settling_time_s"]
+    lines = [
+        f"scenario {s['scenario']} | mode {s['mode']} | bus {s['bus']} | seed {s['seed']}",
+        f"sim {s['sim_time_s']:.1f} s in {_fmt(s['wall_time_s'], '.2f')} s wall "
+        f"(real-time factor {_fmt(s['realtime_factor'], '.1f')})",
+        f"converged {s['converged']} | settling "
+        f"{_settling_text(settling)} | steady-state error "
+        f"{_fmt(s['steady_state_attitude_error_deg'])} deg, "
+        f"{_fmt(s['steady_state_rate_error_deg_s'])} deg/s",
+        f"propellant {s['propellant_kg'] * 1000:.1f} g | valve openings "
+        f"{(s.get('valve_openings') or {}).get('total', 'n/a')}",
+        f"latency sensor->command p50 {_fmt(lat['p50'], '.0f')} us, p99 {_fmt(lat['p99'], '.0f')}"
+        f" us, max {_fmt(lat['max'], '.0f')} us (n={lat['n']}) | stalls {dm.get('stalls', 0)}, "
+        f"flight-software overruns {dm.get('fsw_overruns', 0)}, "
+        f"bench late {dm.get('bench_late', 0)}",
+    ]
+    if not s["converged"]:  # a run fails on this alone, with or without expectations
+        lines.append(f"  FAIL converged: the attitude error did not end inside the "
+                     f"{_fmt(s.get('settling_band_deg'), 'g')} deg settling band")
+    for e in s["expectations"]:
+        lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {_fmt(e['value'])} "
+                     f"(max {e['max']}{'; ' + e['note'] if e.get('note') else ''})")
+    for w in s.get("warnings", []):
+        lines.append(f"  WARNING {w}")
+    if "error" in s:
+        lines.append(f"  ERROR {s['error']}")
+    lines.append(f"run folder: {out}")
+    print("\n".join(lines))
+
+
+def _default_out(name: str) -> Path:
+    return Path("runs") / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
+    from bench.operator.orchestrator import (
+        DEFAULT_FSW_CMD,
+        RunOptions,
+        run_scenario,
+        scenario_warnings,
+    )
+    from bench.scenario import load_scenario
+
+    sc = load_scenario(args.scenario, args.overrides)
+    for w in scenario_warnings(sc):  # said before the run too, not only in its summary
+        print(f"thruster-hil: warning: {w}", file=sys.stderr)
+    bus = args.bus or default_bus_spec()
+    BusSpec.parse(bus)
+    opts = RunOptions(
+        mode=args.mode,
+        bus=bus,
+        seed=sc.seed if args.seed is None else args.seed,
+        out=Path(args.out) if args.out else _default_out(sc.name),
+        duration_s=args.duration if args.duration is not None else sc.duration_s,
+        fsw_cmd=None if alone else (args.fsw_cmd or DEFAULT_FSW_CMD),
+    )
+
+    def ready(config: Path) -> None:
+        print(
+            f"bench ready on {bus}, mode {opts.mode}: waiting up to "
+            f"{sc.bus.startup_timeout_s} s for flight software (FSW_STATUS heartbeat), e.g. "
+            f"`python -m flight_sw --bus {bus} --mode {opts.mode} --config {config}`; "
+            f"its configuration: {config}",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    summary = run_scenario(sc, opts, _progress_printer(), ready if alone else None)
+    if sys.stderr.isatty():
+        sys.stderr.write("\n")
+    _print_summary(summary, opts.out)
+    return EXIT_OK if summary["passed"] else EXIT_FAILED
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from bench.operator.plots import plot_run
+
+    run_dir = Path(args.run_dir)
+    path = run_dir / "summary.json"
+    if not path.exists():
+        raise ConfigError(str(run_dir), "summary.json", None, "a run folder (no summary.json)")
+    s = json.loads(path.read_text(encoding="utf-8"))
+    for p in plot_run(run_dir, s.get("settling_band_deg")):
+        print(f"wrote {p}")
+    _print_summary(s, run_dir)
+    return EXIT_OK if s.get("passed") else EXIT_FAILED
+
+
+def _cmd_timing(args: argparse.Namespace) -> int:
+    from bench.operator.analysis.live import LiveOptions, live_timing
+    from bench.operator.analysis.report import format_report, write_histograms, write_json
+    from bench.operator.analysis.timing import RunTiming, TimingOptions
+
+    if args.live == (args.run_dir is not None):
+        raise ConfigError("timing", "RUN_DIR/--live", args.run_dir, "a run folder or --live")
+    options = TimingOptions(
+        window_ms=args.window_ms,
+        cycle_abs_tolerance_ms=None if args.abs_tol_ms < 0 else args.abs_tol_ms,
+        cycle_rel_tolerance_pct=None if args.rel_tol_pct < 0 else args.rel_tol_pct,
+    )
+    if args.live:
+        bus = args.bus or default_bus_spec()
+        BusSpec.parse(bus)
+        live = LiveOptions(args.duration, args.first_frame_timeout, args.bitrate)
+
+        def listening() -> None:
+            print(
+                f"listening on {bus}: {live.duration_s:g} s from the first frame "
+                f"(waiting up to {live.first_frame_timeout_s:g} s for it)",
+                file=sys.stderr,
+                flush=True,
+            )
+
+        rt, cap = live_timing(bus, live, options, listening=listening)
+        extra = {"bus": bus, "error_frames": cap.error_frames, "fd_frames": cap.fd_frames}
+        if args.json:
+            print(json.dumps({**rt.to_dict(), **extra}, indent=2))
+        else:
+            print(format_report(rt))
+            print(
+                f"bus {bus}: {len(cap.frames)} frames, {cap.error_frames} error frames, "
+                f"{cap.fd_frames} CAN FD frames (not timed)"
+            )
+    else:
+        run_dir = Path(args.run_dir)
+        if not (run_dir / "summary.json").exists():  # bad input, as for `report`
+            raise ConfigError(str(run_dir), "summary.json", None, "a run folder (no summary.json)")
+        rt = RunTiming.load(run_dir, options)
+        written = [write_json(rt, run_dir), *write_histograms(rt, run_dir)]
+        if args.json:
+            print(json.dumps(rt.to_dict(), indent=2))
+        else:
+            print(format_report(rt))
+            for p in written:
+                print(f"wrote {p}")
+    return EXIT_FAILED if args.strict and (rt.flagged() or rt.unheard()) else EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of ``thruster-hil``."""
+    p = argparse.ArgumentParser(prog="thruster-hil", description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    for name, help_ in (
+        ("run", "run a scenario: bench + flight software"),
+        ("bench", "run the bench alone; pair it with external flight software"),
+    ):
+        r = sub.add_parser(name, help=help_)
+        r.add_argument("scenario", help="scenario TOML file")
+        r.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
+        r.add_argument(
+            "--bus",
+            help="bus spec INTERFACE:CHANNEL (default: socketcan:vcan0 if "
+            "present, else hilbus:default)",
+        )
+        r.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
+        r.add_argument("--out", help="run folder (default: runs/<scenario>-<time>)")
+        r.add_argument("--duration", type=float, help="override the scenario duration [s]")
+        r.add_argument("--set", dest="overrides", action="append", default=[],
+                       metavar="KEY=VALUE",
+                       help="override a scenario value, e.g. --set bus.bitrate_bps=125000 "
+                       "(repeatable; TOML values)")
+        if name == "run":
+            r.add_argument(
+                "--fsw-cmd",
+                help="flight-software command; placeholders {bus} {mode} "
+                "{config} {stats} {rx_log} {run_dir}",
+            )
+    rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
+    rp.add_argument("run_dir")
+    _add_timing_parser(sub)
+    inj = sub.add_parser("inject", help="inject or clear a fault live on a running bench "
+                         "(a FAULT_CMD frame, acknowledged by the bench)")
+    inj.add_argument("kind", help="fault kind, e.g. stuck_open, degraded, drop, bus_off, outage")
+    inj.add_argument("--bus", help="bus spec of the running bench")
+    inj.add_argument("--target", type=_integer, required=True,
+                     help="thruster index, sensor index (0 gyro, 1 accelerometer, 2 star "
+                     "tracker), message CAN ID (e.g. 0x40) or node index (0 BENCH, 1 FSW)")
+    inj.add_argument("--duration", type=float, default=0.0,
+                     help="seconds of the bench's time (simulated in lockstep, wall clock in "
+                     "realtime); 0 = until cleared")
+    inj.add_argument("--param", type=float, default=0.0,
+                     help="the kind's parameter (factor, probability, delay s, ...)")
+    inj.add_argument("--clear", action="store_true", help="clear the fault instead")
+    inj.add_argument("--print-frame", type=int, metavar="COUNTER",
+                     help="only print the frame for cansend, with this alive counter")
+    cp = sub.add_parser("campaign", help="every single-thruster stuck_closed / stuck_open "
+                        "failure of a scenario, one lockstep run each; CSV + PNG")
+    from bench.operator.campaign import add_arguments
+
+    add_arguments(cp, default_jobs=1)
+    return p
+
+
+def _integer(text: str) -> int:
+    """An integer in any base Python reads (``3``, ``0x40``), for argparse."""
+    try:
+        return int(text, 0)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected an integer, e.g. 3 or 0x40") from None
+
+
+def _cmd_inject(args: argparse.Namespace) -> int:
+    from bench.operator.inject import FaultCommand, cansend_string, inject
+
+    cmd = FaultCommand(args.kind, args.target, args.duration, args.param, args.clear)
+    if args.print_frame is not None:
+        print(cansend_string(cmd, args.print_frame))
+        return EXIT_OK
+    bus = args.bus or default_bus_spec()
+    counter = inject(bus, cmd)
+    print(f"{'cleared' if args.clear else 'injected'} {args.kind} target {args.target} on {bus} "
+          f"(acknowledged, counter {counter})")
+    return EXIT_OK
+
+
+def _cmd_campaign(args: argparse.Namespace) -> int:
+    from bench.operator.campaign import main as campaign_main
+
+    return campaign_main([args.scenario, "--out", args.out, "--fault-time", str(args.fault_time),
+                          "--jobs", str(args.jobs), "--kinds", *args.kinds])
+
+
+def _add_timing_parser(sub: Any) -> None:
+    from bench.operator.analysis.defaults import (
+        DEFAULT_CYCLE_ABS_TOLERANCE_MS,
+        DEFAULT_CYCLE_REL_TOLERANCE_PCT,
+        DEFAULT_FIRST_FRAME_TIMEOUT_S,
+        DEFAULT_LIVE_DURATION_S,
+        DEFAULT_WINDOW_MS,
+    )
+
+    t = sub.add_parser(
+        "timing",
+        help="timing of a run folder (table, timing.json, histograms) or of a live bus",
+        description="Per message: count, period mean and jitter, latency p50/p99/max, "
+        "worst-case bound, missed cycles, cycle-time violations; the IMU->command->valve "
+        "chain; bus load per window and per node.",
+    )
+    t.add_argument("run_dir", nargs="?", help="run folder (omit with --live)")
+    t.add_argument(
+        "--window-ms",
+        type=float,
+        default=DEFAULT_WINDOW_MS,
+        help=f"bus-load window [ms] (default {DEFAULT_WINDOW_MS:g})",
+    )
+    t.add_argument(
+        "--abs-tol-ms",
+        type=float,
+        default=DEFAULT_CYCLE_ABS_TOLERANCE_MS,
+        help="absolute cycle-time window, ± ms around GenMsgCycleTime; negative: "
+        f"off (default {DEFAULT_CYCLE_ABS_TOLERANCE_MS:g})",
+    )
+    t.add_argument(
+        "--rel-tol-pct",
+        type=float,
+        default=DEFAULT_CYCLE_REL_TOLERANCE_PCT,
+        help="relative cycle-time window, ± %% of GenMsgCycleTime; negative: off "
+        f"(default {DEFAULT_CYCLE_REL_TOLERANCE_PCT:g})",
+    )
+    t.add_argument("--json", action="store_true", help="print JSON instead of the table")
+    t.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit 1 if a measured latency is above its worst-case bound, or a message "
+        "its sender sent never reached the trace",
+    )
+    t.add_argument("--live", action="store_true", help="listen to a running bus instead")
+    t.add_argument("--bus", help="--live: bus spec INTERFACE:CHANNEL (default as for run)")
+    t.add_argument(
+        "--duration",
+        type=float,
+        default=DEFAULT_LIVE_DURATION_S,
+        help="--live: seconds to listen from the first frame "
+        f"(default {DEFAULT_LIVE_DURATION_S:g})",
+    )
+    t.add_argument(
+        "--first-frame-timeout",
+        type=float,
+        default=DEFAULT_FIRST_FRAME_TIMEOUT_S,
+        help="--live: seconds to wait for the first frame "
+        f"(default {DEFAULT_FIRST_FRAME_TIMEOUT_S:g})",
+    )
+    t.add_argument(
+        "--bitrate",
+        type=int,
+        help="--live: bitrate for the load estimate [bit/s] (default: the DBC's)",
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``thruster-hil`` console script."""
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "report":
+            return _cmd_report(args)
+        if args.command == "timing":
+            return _cmd_timing(args)
+        if args.command == "inject":
+            return _cmd_inject(args)
+        if args.command == "campaign":
+            return _cmd_campaign(args)
+        return _cmd_run(args, alone=args.command == "bench")
+    except (ConfigError, BusError, IcdError) as exc:
+        print(f"thruster-hil: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RunError as exc:
+        print(f"thruster-hil: run error: {exc}", file=sys.stderr)
+        return EXIT_RUN_ERROR
+    except KeyboardInterrupt:
+        print("\nthruster-hil: interrupted (the run folder was completed with what ran)",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+if __name__ == "__main__":
+    sys.exit(main())

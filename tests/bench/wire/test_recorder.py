@@ -1,0 +1,81 @@
+"""The CAN trace: dated when the run started, frame times in run time, readable by python-can;
+deferred writing (lockstep) gives the same files."""
+
+from __future__ import annotations
+
+from datetime import datetime
+from pathlib import Path
+
+import can
+
+from bench.wire.recorder import TelemetryWriter, TraceRecorder
+
+START_WALL_S = 1_780_000_000.25  # a wall-clock instant in 2026
+T_FRAME_NS = 500_000_000
+FRAME_ID = 0x123
+
+
+def test_trigger_block_is_dated_at_the_run_start_and_frames_keep_run_time(tmp_path: Path) -> None:
+    """Begin Triggerblock carries START_WALL_S's date (not 1970); the frame reads back at 0.5 s."""
+    rec = TraceRecorder(tmp_path, START_WALL_S)
+    rec.frame(can.Message(arbitration_id=FRAME_ID, data=b"\x01\x02", is_extended_id=False),
+              T_FRAME_NS, tx=True)
+    rec.close()
+    text = (tmp_path / "trace.asc").read_text()
+    (block,) = [ln for ln in text.splitlines() if ln.startswith("Begin Triggerblock")]
+    start = datetime.fromtimestamp(START_WALL_S)
+    assert start.strftime("%b %d") in block and block.endswith(str(start.year))
+    assert "1970" not in block
+    (msg,) = list(can.LogReader(tmp_path / "trace.asc"))
+    assert msg.arbitration_id == FRAME_ID and msg.timestamp == T_FRAME_NS / 1e9
+
+
+def _record_a_run(run_dir: Path, deferred: bool) -> TraceRecorder:
+    """The same calls a bench makes (frames both ways, an error frame, events, telemetry)."""
+    run_dir.mkdir()
+    rec = TraceRecorder(run_dir, START_WALL_S, deferred)
+    tel = TelemetryWriter(run_dir / "telemetry.csv", ["t_s", "x"], deferred)
+    for k in range(3):
+        t_ns = k * T_FRAME_NS
+        rec.frame(can.Message(arbitration_id=FRAME_ID, data=bytes([k, 2]), is_extended_id=False),
+                  t_ns, tx=True, t_ready_ns=t_ns - 1000, t_start_ns=t_ns - 500, bits=60)
+        rec.event(t_ns + 1, "valve_watchdog", action="all valves closed")  # also in the trace
+        rec.error_frame(t_ns + 2)
+        rec.frame(can.Message(arbitration_id=FRAME_ID + 1, data=b"\x07", is_extended_id=False),
+                  t_ns + 3, tx=False, bits=50)
+        tel.row([t_ns / 1e9, 0.1 * k])
+        if k == 1:
+            rec.flush()
+            tel.flush()
+    rec.close()
+    tel.close()
+    return rec
+
+
+def test_deferred_writing_gives_the_same_files(tmp_path: Path) -> None:
+    """Deferred writing (lockstep) writes exactly what immediate writing does, in trace order."""
+    now = _record_a_run(tmp_path / "now", deferred=False)
+    later = _record_a_run(tmp_path / "later", deferred=True)
+    assert now.frames_written == later.frames_written == 9
+    for name in ("trace.asc", "frames.csv", "events.jsonl", "telemetry.csv"):
+        now_text, later_text = ((tmp_path / d / name).read_text().splitlines()
+                                for d in ("now", "later"))
+        if name == "trace.asc":  # python-can dates the file when it opens it (metadata)
+            now_text, later_text = now_text[1:], later_text[1:]
+            assert now_text[0].startswith("base hex")
+        assert now_text == later_text, name
+    assert len(list(can.LogReader(tmp_path / "later" / "trace.asc"))) == 9
+
+
+def test_deferred_rows_wait_for_write_pending_and_events_do_not(tmp_path: Path) -> None:
+    """Deferred: frames and rows reach the files at write_pending; events.jsonl at once."""
+    rec = TraceRecorder(tmp_path, START_WALL_S, deferred=True)
+    rec.frame(can.Message(arbitration_id=FRAME_ID, data=b"\x01", is_extended_id=False),
+              T_FRAME_NS, tx=True)
+    rec.event(T_FRAME_NS, "fault_injected", kind="stuck_open")
+    rec._writer.file.flush()
+    assert "fault_injected" in (tmp_path / "events.jsonl").read_text()
+    assert list(can.LogReader(tmp_path / "trace.asc")) == []
+    rec.flush()
+    assert len(list(can.LogReader(tmp_path / "trace.asc"))) == 1
+    rec.close()
