@@ -3,11 +3,22 @@
 Out (:class:`Encoder`): a message name and physical signal values in the DBC's units ->
 an 8-byte payload with alive counter and CRC (see :mod:`dbc.e2e`).
 In (:class:`FrameChecker`): a received ``can.Message`` -> decoded physical signals, or a
-rejection counted under one cause of :class:`Reject`. Checks, in order: frame kind (error /
-remote), known ID, DLC, CRC, alive counter (a repeat is rejected; a jump is accepted and
-its missing frames counted as ``gaps``), signal ranges from the DBC. Freshness depends on
-the receiver's notion of time, so the receiver calls :meth:`FrameChecker.reject` with
-``Reject.STALE`` itself. Nothing here raises on bad input: bad frames are counted.
+rejection counted under one cause of :class:`Reject`. Checks, in order: error frame,
+extended (29-bit) ID (the ICD has 11-bit IDs only: an extended frame with the number of a
+known ID is not that message), known ID, remote frame, DLC, CRC, one of this receiver's
+own messages (a well-formed frame of it that another node sends: ``unexpected``; a
+malformed one is counted by its fault), alive counter (a repeat or the
+"invalid" value 15 is rejected; a counter 1..3 behind the last accepted one, while that
+message's stream is live, is a ``sequence`` regression; a jump forward is accepted and
+its missing frames counted as ``gaps``), signal ranges from the DBC.
+
+Two phases: :meth:`FrameChecker.inspect` checks a frame without taking it; the receiver
+then decides what only it can (freshness: a command for another cycle, a SYNC from the
+past) and calls :meth:`FrameChecker.accept` (the alive counter moves on, the frame counts
+as accepted) or :meth:`FrameChecker.reject` with its cause. A rejected frame never moves
+the counter, so it cannot make the next genuine frame look like a repeat.
+:meth:`FrameChecker.check` is both phases at once, for receivers with no freshness rule.
+Nothing here raises on bad input: bad frames are counted.
 
 Scaling, IDs and ranges come only from the database passed in; the bits are packed and
 unpacked by :class:`dbc.layout.FrameLayout`, compiled once per message from it.
@@ -30,6 +41,13 @@ from dbc.layout import FrameLayout
 E2E_DATA_ID_ATTRIBUTE = "E2EDataID"
 BITRATE_ATTRIBUTE = "Baudrate"  # BA_DEF_: default, minimum and maximum bitrate [bit/s]
 RANGE_TOLERANCE = 1e-9  # relative slack on DBC min/max for float round-off
+# A counter this many steps behind the last accepted one is a regression, not a jump: a
+# live sender would have to lose 12 or more frames in a row to look like that.
+REGRESSION_MAX_STEPS = 3
+# ... while the stream is live: its last frame is at most this many of its periods old
+# (after a longer silence, e.g. a restarted sender, any counter starts a new sequence).
+LIVE_PERIODS = 3
+NS_PER_MS = 1_000_000
 
 
 class Reject(str, Enum):
@@ -42,8 +60,11 @@ class Reject(str, Enum):
     CRC = "crc"
     COUNTER = "counter"  # repeated or invalid (15) alive counter
     RANGE = "range"
-    STALE = "stale"
+    SEQUENCE = "sequence"  # alive counter 1..3 behind the live stream's: a replay or a 2nd sender
+    STALE = "stale"  # for another cycle, or older than what was already taken
     UNEXPECTED = "unexpected"  # one of this node's own messages, sent by another node
+    EXTENDED_ID = "extended_id"  # a 29-bit ID: no message of the ICD
+    SECOND_SENDER = "second_sender"  # a second, different frame of an ID for the same cycle
 
 
 def data_id(message: Message) -> int:
@@ -154,12 +175,14 @@ class Encoder:
 
 @dataclass
 class Decoded:
-    """A frame that passed every check."""
+    """A frame that passed every check of :meth:`FrameChecker.inspect`."""
 
     name: str
     signals: dict[str, float]
     counter: int
     gap: int  # frames missed before this one according to the alive counter
+    frame_id: int = 0
+    t_ns: int = 0  # the receiver's time of receipt, as given to inspect
 
 
 @dataclass
@@ -184,72 +207,102 @@ class FrameChecker:
         """
         self._by_id: dict[int, tuple[Message, int, list[tuple[str, float, float]], FrameLayout]]
         self._by_id = {}
+        self._live_ns: dict[int, int] = {}
         for m in db.messages:
             self._by_id[m.frame_id] = (m, data_id(m), _range_checks(m), FrameLayout(m))
+            if m.cycle_time:
+                self._live_ns[m.frame_id] = LIVE_PERIODS * int(m.cycle_time) * NS_PER_MS
         self._accept = accept
         self._own = own
         self._last_counter: dict[int, int] = {}
+        self._last_t_ns: dict[int, int] = {}
         self.stats: dict[str, FrameStats] = defaultdict(FrameStats)
+        self.last_cause: Reject | None = None  # why the last frame inspected was rejected
 
     def reject(self, name: str, cause: Reject) -> None:
-        """Count a rejection of ``name`` for ``cause`` (used by receivers for STALE)."""
-        self.stats[name].rejected[cause.value] += 1
+        """Count a frame of ``name`` rejected for ``cause`` (e.g. STALE, by the receiver)."""
+        st = self.stats[name]
+        st.received += 1
+        st.rejected[cause.value] += 1
+        self.last_cause = cause
 
-    def check(self, msg: can.Message) -> Decoded | None:
-        """Decoded signals if ``msg`` passes every check, else None (and the cause is counted)."""
+    def check(self, msg: can.Message, t_ns: int = 0) -> Decoded | None:
+        """:meth:`inspect` then :meth:`accept`: the decoded frame, or None (cause counted)."""
+        d = self.inspect(msg, t_ns)
+        if d is not None:
+            self.accept(d)
+        return d
+
+    def accept(self, d: Decoded) -> None:
+        """Take a frame :meth:`inspect` passed: its counter becomes the last one."""
+        self._last_counter[d.frame_id] = d.counter
+        self._last_t_ns[d.frame_id] = d.t_ns
+        st = self.stats[d.name]
+        st.received += 1
+        st.accepted += 1
+        st.gaps += d.gap
+
+    def inspect(self, msg: can.Message, t_ns: int = 0) -> Decoded | None:
+        """Decoded signals if ``msg`` passes every check (not yet taken), else None.
+
+        ``t_ns``: the receiver's time of receipt (any consistent clock), which decides
+        whether the message's stream is live for the regression check. Rejections are
+        counted here, by cause (and the last one kept in :attr:`last_cause`).
+        """
+        self.last_cause = None
         if msg.is_error_frame:
-            self._count_reject("error_frame", Reject.ERROR_FRAME)
+            self.reject("error_frame", Reject.ERROR_FRAME)
+            return None
+        if msg.is_extended_id:
+            self.reject(f"0x{msg.arbitration_id:08X}x", Reject.EXTENDED_ID)
             return None
         entry = self._by_id.get(msg.arbitration_id)
-        if entry is None or msg.is_extended_id:
-            self._count_reject(f"0x{msg.arbitration_id:03X}", Reject.UNKNOWN_ID)
+        if entry is None:
+            self.reject(f"0x{msg.arbitration_id:03X}", Reject.UNKNOWN_ID)
             return None
         message, did, limits, layout = entry
         name = message.name
-        if self._accept is not None and name not in self._accept:
-            if name in self._own:
-                self._count_reject(name, Reject.UNEXPECTED)
+        own = name in self._own
+        if self._accept is not None and name not in self._accept and not own:
             return None
         if msg.is_remote_frame:
-            self._count_reject(name, Reject.REMOTE_FRAME)
+            self.reject(name, Reject.REMOTE_FRAME)
             return None
         data = msg.data
         if msg.dlc != message.length or len(data) != message.length:
-            self._count_reject(name, Reject.DLC)
+            self.reject(name, Reject.DLC)
             return None
         if not e2e.crc_ok(did, data):
-            self._count_reject(name, Reject.CRC)
+            self.reject(name, Reject.CRC)
+            return None
+        if own:  # a well-formed frame of ours that we did not send: a second sender
+            self.reject(name, Reject.UNEXPECTED)
             return None
         counter = e2e.counter_of(data)
-        last = self._last_counter.get(msg.arbitration_id)
         if counter >= e2e.COUNTER_MODULUS:
-            self._count_reject(name, Reject.COUNTER)
+            self.reject(name, Reject.COUNTER)
             return None
         gap = 0
+        fid = msg.arbitration_id
+        last = self._last_counter.get(fid)
         if last is not None:
             delta = e2e.counter_delta(last, counter)
             if delta == 0:
-                self._count_reject(name, Reject.COUNTER)
+                self.reject(name, Reject.COUNTER)
+                return None
+            live_ns = self._live_ns.get(fid)
+            if (delta >= e2e.COUNTER_MODULUS - REGRESSION_MAX_STEPS and live_ns is not None
+                    and t_ns - self._last_t_ns[fid] <= live_ns):
+                self.reject(name, Reject.SEQUENCE)
                 return None
             gap = delta - 1
         signals = layout.unpack(data)
         for sig_name, lo, hi in limits:
             v = signals[sig_name]
             if v < lo or v > hi:
-                self._count_reject(name, Reject.RANGE)
-                self._last_counter[msg.arbitration_id] = counter
+                self.reject(name, Reject.RANGE)
                 return None
-        self._last_counter[msg.arbitration_id] = counter
-        st = self.stats[name]
-        st.received += 1
-        st.accepted += 1
-        st.gaps += gap
-        return Decoded(name, signals, counter, gap)
-
-    def _count_reject(self, name: str, cause: Reject) -> None:
-        st = self.stats[name]
-        st.received += 1
-        st.rejected[cause.value] += 1
+        return Decoded(name, signals, counter, gap, fid, t_ns)
 
     def summary(self) -> dict[str, dict[str, Any]]:
         """Plain-dict statistics: per message received, accepted, gaps and rejected by cause."""

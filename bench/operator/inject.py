@@ -15,16 +15,17 @@ from dataclasses import dataclass
 
 import can
 
-from bench.station.faults import FAULT_CMD_KINDS
 from dbc import e2e, load_database
 from dbc.bus import open_bus
 from dbc.codec import Encoder, FrameChecker
 from dbc.errors import ConfigError, RefusedConfigError, RunError
+from dbc.icd import Icd
 
-COUNTER_NONE = 15
 INJECT_SOURCE = "thruster-hil inject"
 DEFAULT_TIMEOUT_S = 5.0
-KIND_CODES = {kind: code for code, kind in FAULT_CMD_KINDS.items()}
+ICD = Icd.from_database(load_database())
+COUNTER_NONE = ICD.fault_cmd_counter_none
+KIND_CODES = {kind: code for code, kind in ICD.fault_kinds.items()}
 
 
 @dataclass(frozen=True)
@@ -53,7 +54,8 @@ class FaultCommand:
 
     def signals(self) -> dict[str, float | int]:
         """FAULT_CMD signal values."""
-        return {"Action": 0 if self.clear else 1, "FaultType": KIND_CODES[self.kind],
+        action = ICD.fault_actions["clear" if self.clear else "inject"]
+        return {"Action": action, "FaultType": KIND_CODES[self.kind],
                 "Target": self.target, "Duration": self.duration_s, "Param": self.param}
 
 

@@ -31,18 +31,20 @@ from typing import Any
 
 import numpy as np
 
-from bench.node import BenchNode, frame_table, merge_counts, zero_unheard
+from bench.node import BenchNode
 from bench.operator.analysis.reception import RX_LOG_FILE
 from bench.operator.authority import WRENCH_CONTROLLERS, authority_warnings
 from bench.operator.plausibility import mass_warnings
+from bench.results.counts import frame_table, merge_counts, zero_unheard
 from bench.results.metrics import pointing_metrics
+from bench.results.writers import write_summary
 from bench.scenario import Scenario
-from bench.wire.recorder import write_summary
 from dbc import load_database
 from dbc.bus import available_cpus, lockstep_spin_s, mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 from dbc.hilbus import MEMBER_STALL_S
+from dbc.icd import Icd
 
 DEFAULT_FSW_CMD = (
     f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
@@ -467,7 +469,7 @@ def partial_summary(
                           tel.get("rate_err_deg_s", np.zeros(0)),
                           sc.expectations.settling_band_deg, sc.expectations.steady_state_window_s,
                           sc.manoeuvre_start_s)
-    frames = frame_table(db)
+    frames = frame_table(Icd.from_database(db))
     fr = _read_numeric_csv(out / "frames.csv")
     name_of = {m.frame_id: m.name for m in db.messages}
     sent: dict[str, int] = {}

@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from dbc.errors import ConfigError
+from dbc.icd import Icd
 from dbc.schema import Table
 
 THRUSTER_KINDS = ("stuck_closed", "stuck_open", "degraded", "delayed", "intermittent", "leak",
@@ -87,50 +88,6 @@ class FaultSpec:
         return out
 
 
-@dataclass(frozen=True)
-class Fate:
-    """What the active faults do to one frame."""
-
-    drop: bool = False
-    delay_ns: int = 0
-    corrupt_bit: int | None = None  # bit index in bytes 1..7 to flip
-    duplicate: bool = False
-    failed_attempts: int = 0
-
-
-NO_FATE = Fate()
-PAYLOAD_BITS = 56  # bytes 1..7: the CRC byte itself is not flipped, the CRC must catch it
-
-
-def frame_fate(active: list[FaultSpec], name: str, sender: str, rng: Any) -> Fate:
-    """Fate of one frame of ``name`` from ``sender`` under the ``active`` faults.
-
-    Draws from ``rng`` only for matching faults, in the order they were started, so the
-    same seed gives the same fates (lockstep determinism).
-    """
-    drop = dup = False
-    delay = fails = 0
-    bit = None
-    for f in active:
-        if f.kind not in FRAME_KINDS or not (f.message == name or f.node == sender):
-            continue
-        if rng.random() >= f.params["probability"]:
-            continue
-        if f.kind == "drop":
-            drop = True
-        elif f.kind == "delay":
-            delay += round(f.params["delay_s"] * 1e9)
-        elif f.kind == "corrupt":
-            bit = int(rng.integers(PAYLOAD_BITS))
-        elif f.kind == "duplicate":
-            dup = True
-        else:
-            fails += 1
-    if not (drop or dup or delay or fails or bit is not None):
-        return NO_FATE
-    return Fate(drop, delay, bit, dup, fails)
-
-
 def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
                  messages: frozenset[str], nodes: frozenset[str]) -> tuple[FaultSpec, ...]:
     """Validate ``[[faults]]`` tables; sorted by start time."""
@@ -172,7 +129,7 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
             if can_id > MAX_STD_ID:
                 raise f.error("can_id", can_id, f"an 11-bit ID 0..{MAX_STD_ID}")
             rate_hz = f.number("rate_hz", lo=0.0, lo_open=True, hi=MAX_RATE_HZ)
-            spec = FaultSpec(t_s, kind, dur, node=f.string("node", "BABBLER"),
+            spec = FaultSpec(t_s, kind, dur, node=f.string("node", BABBLER),
                              params={"can_id": can_id, "rate_hz": rate_hz})
         else:  # bus_off
             spec = FaultSpec(t_s, kind, dur, node=f.string("node", choices=tuple(sorted(nodes))))
@@ -181,40 +138,34 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
     return tuple(sorted(out, key=lambda x: x.t_s))
 
 
-# FAULT_CMD.FaultType values (the DBC's VAL_ table) this bench acts on, and FAULT_CMD.Target
-# node indices for node faults.
-FAULT_CMD_KINDS = {1: "stuck_closed", 2: "stuck_open", 3: "degraded", 4: "misaligned",
-                   5: "delayed", 6: "intermittent", 7: "leak", 8: "drop", 9: "delay",
-                   10: "corrupt", 11: "duplicate", 12: "babbling", 13: "bus_off",
-                   14: "link_error", 15: "bias_jump", 16: "frozen", 17: "outage", 18: "noise"}
 # the single Param of a FAULT_CMD, per kind that takes one
 FAULT_CMD_PARAM = {"degraded": "factor", "misaligned": "angle_deg", "delayed": "extra_delay_s",
                    "intermittent": "dropout_probability", "leak": "thrust_N", "noise": "factor"}
 FAULT_CMD_AXIS_B = (0.0, 0.0, 1.0)  # misalignment axis of a FAULT_CMD (not encodable)
-FAULT_CMD_NODES = ("BENCH", "FSW")
 FAULT_CMD_SOURCE = "FAULT_CMD"  # where a refused live command's bad value came from
+BABBLER = "BABBLER"  # the node name of a babbling fault's frames
 KHZ = 1000.0
 
 
-def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thrusters: int,
+def fault_from_command(signals: dict[str, float], icd: Icd, n_thrusters: int,
                        t_s: float) -> FaultSpec:
     """The fault a FAULT_CMD frame describes (see its DBC comments).
 
     Target is a thruster index (thruster kinds), a sensor index (0 gyro, 1 accelerometer,
     2 star tracker), the CAN ID of a message (frame kinds), the CAN ID to babble with
-    (babbling), or a node index (bus_off). Param is the kind's one parameter: factor,
-    angle (deg, about z_B), extra delay (s), dropout probability, leak thrust (N), bias jump
-    on the sensor's x axis, probability (frame kinds, 0 = 1; at most 1), delay (s) or rate
-    (kHz, babbling). Raises :class:`ConfigError` (source ``FAULT_CMD``) naming the signal
-    and value this bench cannot apply.
+    (babbling), or a node index into the DBC's node list (bus_off). Param is the kind's one
+    parameter: factor, angle (deg, about z_B), extra delay (s), dropout probability, leak
+    thrust (N), bias jump on the sensor's x axis, probability (frame kinds, 0 = 1; at most
+    1), delay (s) or rate (kHz, babbling). Raises :class:`ConfigError` (source
+    ``FAULT_CMD``) naming the signal and value this bench cannot apply.
     """
     code = int(signals["FaultType"])
-    kind = FAULT_CMD_KINDS.get(code)
+    kind = icd.fault_kinds.get(code)
     target, param = int(signals["Target"]), float(signals["Param"])
     dur = float(signals["Duration"])
     if kind is None:
         raise ConfigError(FAULT_CMD_SOURCE, "FaultType", code,
-                          f"one of {sorted(FAULT_CMD_KINDS)} (see the DBC's VAL_ table)")
+                          f"one of {sorted(icd.fault_kinds)} (see the DBC's VAL_ table)")
     if kind in THRUSTER_KINDS:
         if target >= n_thrusters:
             raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
@@ -237,20 +188,19 @@ def fault_from_command(signals: dict[str, float], name_of: dict[int, str], n_thr
             params[BIAS_JUMP_PARAM[sensor]] = (param, 0.0, 0.0)
         return FaultSpec(t_s, kind, dur, sensor=sensor, params=params)
     if kind == "bus_off":
-        if target >= len(FAULT_CMD_NODES):
+        if target >= len(icd.nodes):
             raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
-                              f"a node index 0..{len(FAULT_CMD_NODES) - 1} "
-                              f"({', '.join(FAULT_CMD_NODES)})")
-        return FaultSpec(t_s, kind, dur, node=FAULT_CMD_NODES[target])
+                              f"a node index 0..{len(icd.nodes) - 1} ({', '.join(icd.nodes)})")
+        return FaultSpec(t_s, kind, dur, node=icd.nodes[target])
     if kind == "babbling":
         if target > MAX_STD_ID:
             raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
                               f"an 11-bit CAN ID 0..0x{MAX_STD_ID:X} to babble with")
         if not param > 0:
             raise ConfigError(FAULT_CMD_SOURCE, "Param", param, "a babbling rate > 0 kHz")
-        return FaultSpec(t_s, kind, dur, node="BABBLER",
+        return FaultSpec(t_s, kind, dur, node=BABBLER,
                          params={"can_id": target, "rate_hz": param * KHZ})
-    message = name_of.get(target)
+    message = icd.name_by_id.get(target)
     if message is None:
         raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
                           f"the CAN ID of a DBC message for {kind}")

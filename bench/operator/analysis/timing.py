@@ -2,7 +2,8 @@
 
 What
 ----
-Measurements over the timing files of a run folder (written by :mod:`bench.wire.recorder`):
+Measurements over the timing files of a run folder (written by :mod:`bench.wire.trace` and
+:mod:`bench.results.writers`):
 
 * per message: count, period mean and jitter (standard deviation and max - min of the
   inter-arrival times), latency ``t_rx - t_ready`` p50/p99/max, missed cycles and
@@ -96,7 +97,8 @@ from bench.operator.analysis.reception import (
     receive_log,
 )
 from bench.operator.analysis.rta import messages_from_dbc, response_times
-from bench.wire.recorder import CHAIN_COLUMNS, FRAME_COLUMNS
+from bench.results.writers import CHAIN_COLUMNS
+from bench.wire.trace import FRAME_COLUMNS
 from dbc import load_database
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps
 from dbc.e2e import COUNTER_MODULUS

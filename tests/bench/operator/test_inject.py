@@ -8,13 +8,14 @@ from typing import Any
 import pytest
 
 from bench.operator.inject import KIND_CODES, FaultCommand, cansend_string
-from bench.station.faults import FAULT_CMD_KINDS, fault_from_command
+from bench.station.faults import fault_from_command
 from dbc import load_database
 from dbc.errors import ConfigError
+from dbc.icd import Icd
 
 N_THRUSTERS = 8
-NAME_OF = {m.frame_id: m.name for m in load_database().messages}
-IMU_RATE_ID = next(i for i, n in NAME_OF.items() if n == "IMU_RATE")
+ICD = Icd.from_database(load_database())
+IMU_RATE_ID = ICD.frame_id["IMU_RATE"]
 
 
 def _cmd(kind: str, target: int, param: float = 0.0) -> dict[str, float]:
@@ -46,21 +47,21 @@ def test_fault_cmd_the_bench_cannot_apply_says_why(kind: str, target: int, param
                                                    says: str) -> None:
     """A live FAULT_CMD with a target or parameter this bench lacks: ConfigError naming it."""
     with pytest.raises(ConfigError, match=re.escape(f"FAULT_CMD: {says}")):
-        fault_from_command(_cmd(kind, target, param), NAME_OF, N_THRUSTERS, 0.0)
+        fault_from_command(_cmd(kind, target, param), ICD, N_THRUSTERS, 0.0)
 
 
 def test_unknown_fault_type_code_is_refused() -> None:
     """A FaultType code outside the VAL_ table: ConfigError naming the code."""
-    cmd = {**_cmd("drop", IMU_RATE_ID), "FaultType": max(FAULT_CMD_KINDS) + 1}
+    cmd = {**_cmd("drop", IMU_RATE_ID), "FaultType": max(ICD.fault_kinds) + 1}
     with pytest.raises(ConfigError, match="FaultType"):
-        fault_from_command(cmd, NAME_OF, N_THRUSTERS, 0.0)
+        fault_from_command(cmd, ICD, N_THRUSTERS, 0.0)
 
 
 def test_applicable_fault_cmd_builds_its_fault() -> None:
     """stuck_open on thruster 3 and drop (p 0.25) on IMU_RATE give the matching FaultSpec."""
-    f = fault_from_command(_cmd("stuck_open", 3), NAME_OF, N_THRUSTERS, 1.5)
+    f = fault_from_command(_cmd("stuck_open", 3), ICD, N_THRUSTERS, 1.5)
     assert (f.kind, f.thruster, f.t_s) == ("stuck_open", 3, 1.5)
-    d = fault_from_command(_cmd("drop", IMU_RATE_ID, 0.25), NAME_OF, N_THRUSTERS, 0.0)
+    d = fault_from_command(_cmd("drop", IMU_RATE_ID, 0.25), ICD, N_THRUSTERS, 0.0)
     assert (d.message, d.params["probability"]) == ("IMU_RATE", 0.25)
 
 

@@ -24,7 +24,8 @@ from bench.operator.analysis.timing import (
     period_stats_s,
     window_busy_s,
 )
-from bench.wire.recorder import CHAIN_COLUMNS, FRAME_COLUMNS
+from bench.results.writers import CHAIN_COLUMNS
+from bench.wire.trace import FRAME_COLUMNS
 from dbc import load_database
 from dbc.errors import ConfigError, RunError
 from dbc.hilbus import HilMessage

@@ -4,18 +4,14 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
 import pytest
 
-from bench.station.faults import NO_FATE, FaultSpec, frame_fate, parse_faults
+from bench.station.faults import FaultSpec, parse_faults
 from dbc.errors import ConfigError
 from dbc.schema import Table
 
 MESSAGES = frozenset({"IMU_RATE", "THR_CMD_0"})
 NODES = frozenset({"BENCH", "FSW"})
-N_FATES = 20_000
-P = 0.3
-SIGMAS = 5.0
 
 
 def _parse(entry: dict[str, Any]) -> FaultSpec:
@@ -67,13 +63,3 @@ def test_bad_entries_name_the_key(entry: dict, key: str) -> None:  # type: ignor
     with pytest.raises(ConfigError) as info:
         _parse({"t_s": 1.0, **entry})
     assert info.value.key == key
-
-
-def test_frame_fate_probability_and_targeting() -> None:
-    """A drop at p hits about p of matching frames and never a frame of another message."""
-    spec = _parse({"t_s": 0.0, "kind": "drop", "message": "IMU_RATE", "probability": P})
-    rng = np.random.default_rng(1)
-    hits = sum(frame_fate([spec], "IMU_RATE", "BENCH", rng).drop for _ in range(N_FATES))
-    sigma = (N_FATES * P * (1 - P)) ** 0.5
-    assert abs(hits - P * N_FATES) <= SIGMAS * sigma
-    assert frame_fate([spec], "THR_CMD_0", "FSW", rng) is NO_FATE

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import can
 
-from bench.wire.recorder import TelemetryWriter, TraceRecorder
+from bench.results.writers import TelemetryWriter
+from bench.wire.trace import TraceRecorder
 
 START_WALL_S = 1_780_000_000.25  # a wall-clock instant in 2026
 T_FRAME_NS = 500_000_000

@@ -1,39 +1,36 @@
-"""Run-folder writers that flush as they go: CAN trace (Vector ASC), telemetry CSV, events.
+"""The wire's record of the bus: the CAN trace (Vector ASC), per-frame timing, events.
 
 * ``trace.asc`` — every frame the bench sent or received, in wire order, with its
   modelled (lockstep) or measured (realtime) time of reception; Tx = sent by the bench.
   Written through python-can's ``ASCWriter`` so python-can, Vector tools and SavvyCAN
   read it; flushed once per control cycle, so a crash loses at most one cycle.
-* ``telemetry.csv`` — one row per telemetry sample (truth, sensors, estimates, commands);
-  a header row names each column with its unit; flushed per cycle.
 * ``frames.csv`` — one row per frame of the trace, same order: when it was queued for
   transmission (``t_ready_s``), when it won arbitration (``t_start_s``), when it was received
   (``t_rx_s``), ID, DLC, bits on the wire, ``tx`` (1 = sent by the bench) and alive counter.
   Lockstep: modelled times; realtime: measured (``nan`` where the bench cannot know, e.g.
   when the flight software received a bench frame, or a sender's time on SocketCAN).
-* ``chains.csv`` — per control cycle, the end-to-end chain IMU sample -> command -> valve:
-  newest IMU_RATE used (its transmit time), last THR_CMD reception, first valve opening.
-* ``events.jsonl`` — one JSON object per event (faults, watchdog, stalls), flushed per line.
+* ``events.jsonl`` — one JSON object per event (faults, watchdog, stalls), flushed per line;
+  the events of :data:`TRACE_EVENTS` also go into the trace as ASC event lines.
 
-Deferred writing (``deferred=True``, the lockstep bench): rows and trace lines are kept as
-values and formatted into the files by :meth:`write_pending` (also called by ``flush`` and
-``close``), so that a bench can do the text formatting while the flight software computes
-its cycle instead of between its frames. The files' content is the same either way;
-``events.jsonl`` is always written and flushed at once.
+Deferred writing (``deferred=True``, the lockstep bench): frames and trace lines are kept as
+values and formatted into the files by :meth:`TraceRecorder.write_pending` (also called by
+``flush`` and ``close``), so that a bench can do the text formatting while the flight
+software computes its cycle instead of between its frames. The files' content is the same
+either way; ``events.jsonl`` is always written and flushed at once.
 
 No clock is read here: every timestamp is passed in (the trace's start date too).
 """
 
 from __future__ import annotations
 
-import csv
 import json
-import math
 from datetime import datetime
 from pathlib import Path
 from typing import IO, Any
 
 import can
+
+from bench.results.writers import TelemetryWriter
 
 NS_PER_S = 1e9
 US_PER_MS = 1000
@@ -43,12 +40,7 @@ TRACE_EVENTS = frozenset({"fault_injected", "fault_cleared", "valve_watchdog",
                           "valve_watchdog_cleared", "fsw_silent", "fsw_back", "fsw_restart"})
 COUNTER_MASK = 0x0F
 FRAME_COLUMNS = ["t_ready_s", "t_start_s", "t_rx_s", "id", "dlc", "bits", "tx", "counter"]
-# per control cycle: IMU sample sent, last command frame received, first command frame that
-# fires a valve received, that valve opening (nan: no valve fired)
-CHAIN_COLUMNS = ["cycle", "imu_counter", "t_imu_tx_s", "t_cmd_rx_s", "t_fire_cmd_rx_s",
-                 "t_valve_open_s"]
 PENDING_FRAME, PENDING_ERROR, PENDING_EVENT = 0, 1, 2  # kinds of a deferred trace line
-NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at 1e4 s
 
 
 class TraceRecorder:
@@ -161,57 +153,3 @@ class TraceRecorder:
         self._events.close()
 
 
-class TelemetryWriter:
-    """``telemetry.csv`` with a fixed column list, flushed on demand."""
-
-    def __init__(self, path: Path, columns: list[str], deferred: bool = False) -> None:
-        """``deferred``: keep rows until :meth:`write_pending` (see the module docstring)."""
-        self.path = path
-        self.deferred = deferred
-        self._pending: list[list[float | int]] = []
-        self._file: IO[str] = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
-        csv.writer(self._file).writerow(columns)
-        self.columns = columns
-        self._fmt = ",".join([NUMBER_FORMAT] * len(columns)) + "\n"
-
-    def row(self, values: list[float | int]) -> None:
-        """Append one row of numbers (same order as the columns), 10 significant digits."""
-        if self.deferred:
-            self._pending.append(values)
-        else:
-            self._file.write(self._fmt % tuple(values))
-
-    def write_pending(self) -> None:
-        """Format the rows deferred writing kept into the file; not flushed."""
-        if self._pending:
-            fmt = self._fmt
-            self._file.write("".join([fmt % tuple(v) for v in self._pending]))
-            self._pending.clear()
-
-    def flush(self) -> None:
-        """Flush to disk."""
-        self.write_pending()
-        self._file.flush()
-
-    def close(self) -> None:
-        """Close the file."""
-        self.write_pending()
-        self._file.close()
-
-
-def _clean(x: Any) -> Any:
-    """JSON-safe: NaN and infinities become null."""
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    return x
-
-
-def write_summary(path: Path, summary: dict[str, Any]) -> None:
-    """Write ``summary`` as strict JSON (NaN and infinities as null), atomically."""
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(_clean(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    tmp.replace(path)

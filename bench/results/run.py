@@ -1,0 +1,159 @@
+"""The results room: everything a run measures, written as it goes, and summary.json.
+
+In (from the node, as the run goes): telemetry instants (bench.results.telemetry), valve
+pulses, the IMU_RATE samples sent (alive counter -> time sent [ns]) and, per control
+cycle, the IMU sample a command was computed from, the last command's and the first
+firing command's reception [ns] (-> ``chains.csv`` and the sensor-to-command latency),
+stalls, the lockstep cycle's wall time and its wait for the flight software [ns], the
+realtime plant's lag behind the wall clock [ns]. Out: ``telemetry.csv``, ``chains.csv``,
+``valve_pulses.csv`` (flushed as the run goes) and the bench's part of ``summary.json``
+(:meth:`Results.summary`), built from these and from the station, the wire and the
+receive path at the end.
+
+Units: times in the files and the summary in seconds, latencies in microseconds.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from bench.results.counts import frame_table, merge_counts
+from bench.results.fsw_view import FswView
+from bench.results.metrics import latency_summary
+from bench.results.summary import expectations_and_metrics
+from bench.results.telemetry import Telemetry
+from bench.results.writers import CHAIN_COLUMNS, PULSE_COLUMNS, TelemetryWriter
+from bench.scenario import Scenario
+from bench.station.station import Pulse, Station
+from bench.wire.receipt import Receipt
+from bench.wire.wire import Wire
+from dbc.icd import BENCH, Icd
+
+NAN = float("nan")
+NS_PER_S = 1_000_000_000
+NS_PER_MS = 1e6
+
+
+class Results:
+    """One run's measurements (see the module docstring)."""
+
+    def __init__(self, sc: Scenario, icd: Icd, run_dir: Path, mode: str, seed: int,
+                 bus_spec: str, n_thrusters: int, open_delay_ns: int) -> None:
+        self.sc, self.icd, self.mode, self.seed, self.bus_spec = sc, icd, mode, seed, bus_spec
+        deferred = mode == "lockstep"
+        self.telemetry = Telemetry(sc, run_dir / "telemetry.csv", n_thrusters, deferred)
+        self.chains = TelemetryWriter(run_dir / "chains.csv", CHAIN_COLUMNS, deferred)
+        self.pulses = TelemetryWriter(run_dir / "valve_pulses.csv", PULSE_COLUMNS, deferred)
+        self.fsw = FswView(icd)
+        self._open_delay_ns = open_delay_ns
+        self.imu_tx_ns: dict[int, int] = {}
+        self.latency_ns: list[int] = []
+        self.cycle_wall_ns: list[int] = []
+        self.fsw_wait_ns: list[int] = []
+        self.stalls = 0
+        self.late_steps = 0
+        self.max_lag_ns = 0
+        self.wall_s = 0.0
+        self.wall_origin_s: float | None = None
+        self.lockstep_spin_s = 0.0
+
+    # -- as the run goes -------------------------------------------------------------
+    def add_pulses(self, pulses: list[Pulse]) -> None:
+        """Commanded valve pulses (valve_pulses.csv)."""
+        for p in pulses:
+            self.pulses.row([p[0], p[1], p[2]])
+
+    def chain(self, cycle: int, imu_counter: int, t_cmd_ns: int, t_fire_ns: int | None) -> None:
+        """One row of chains.csv: IMU sample -> last command frame -> first valve opening.
+
+        ``t_fire_ns``: receipt of the first command frame that fires a valve (the opening
+        follows it by the valve's opening delay), None when no valve fires this cycle.
+        """
+        t_imu = self.imu_tx_ns.get(imu_counter)
+        if t_imu is not None:
+            self.latency_ns.append(t_cmd_ns - t_imu)
+        t_fire = NAN if t_fire_ns is None else t_fire_ns / NS_PER_S
+        t_open = NAN if t_fire_ns is None else (t_fire_ns + self._open_delay_ns) / NS_PER_S
+        self.chains.row([cycle, imu_counter, NAN if t_imu is None else t_imu / NS_PER_S,
+                         t_cmd_ns / NS_PER_S, t_fire, t_open])
+
+    def note_lag(self, lag_ns: int, period_ns: int) -> None:
+        """Realtime: the plant is ``lag_ns`` behind the wall clock."""
+        self.max_lag_ns = max(self.max_lag_ns, lag_ns)
+        if lag_ns > period_ns:
+            self.late_steps += 1
+
+    def write_pending(self) -> None:
+        """Format the deferred rows (lockstep: while the flight software computes)."""
+        self.telemetry.writer.write_pending()
+        self.pulses.write_pending()
+        self.chains.write_pending()
+
+    def flush(self) -> None:
+        """Flush the files to disk."""
+        self.telemetry.writer.flush()
+        self.pulses.flush()
+        self.chains.flush()
+
+    def close(self) -> None:
+        """Finish the files."""
+        self.telemetry.writer.close()
+        self.pulses.close()
+        self.chains.close()
+
+    # -- at the end ------------------------------------------------------------------
+    def summary(self, sim_time_s: float, station: Station, wire: Wire,
+                receipt: Receipt) -> dict[str, Any]:
+        """summary.json content from the bench's side."""
+        sc = self.sc
+        frames = frame_table(self.icd)
+        other: dict[str, dict[str, int]] = {}
+        merge_counts(frames, other, BENCH, wire.sent, receipt.checker.summary())
+        thr = station.plant.thrusters
+        out: dict[str, Any] = {
+            "scenario": sc.name,
+            "scenario_file": sc.path,
+            "overrides": list(sc.overrides),
+            "mode": self.mode,
+            "seed": self.seed,
+            "bus": self.bus_spec,
+            "bitrate_bps": sc.bus.bitrate_bps,
+            "sim_time_s": sim_time_s,
+            "wall_time_s": round(self.wall_s, 3),
+            "wall_clock_origin_s": self.wall_origin_s,
+            "realtime_factor": round(sim_time_s / self.wall_s, 2) if self.wall_s > 0 else None,
+        }
+        out.update(expectations_and_metrics(sc, self.telemetry))
+        out.update({
+            "reference_kind": sc.reference.kind,
+            "translation": sc.dynamics.translation,
+            "valve_model": sc.valve.model,
+            "events": station.captures,
+            "propellant_kg": thr.total_propellant_kg,
+            "valve_openings": {"total": int(sum(thr.openings)),
+                               "per_thruster": list(thr.openings)},
+            "frames": frames,
+            "rejected_other": other,
+            "second_sender_evidence": dict(sorted(receipt.second_sender.items())),
+            "latency_us": {"sensor_to_command": latency_summary(self.latency_ns)},
+            "lockstep_wall_us": None if self.mode != "lockstep" else {
+                "cycle": latency_summary(self.cycle_wall_ns),
+                "waiting_for_fsw": latency_summary(self.fsw_wait_ns),
+                "spin_s": self.lockstep_spin_s,
+            },
+            "deadline_misses": {
+                "bench_late": self.late_steps,
+                "bench_max_lag_ms": round(self.max_lag_ns / NS_PER_MS, 3),
+                "stalls": self.stalls,
+                "fsw_overruns": self.fsw.overruns,
+            },
+            "valve_watchdog_trips": station.watchdog_trips,
+            "fsw_restarts": self.fsw.restarts,
+            "fsw_restarts_refused": self.fsw.restarts_refused,
+            "faults": station.faults.log,
+            "fault_effects": dict(wire.fault_counts),
+            "fdir": self.fsw.fdir,
+        })
+        out["passed"] = all(x["pass"] for x in out["expectations"]) and out["converged"]
+        return out

@@ -1,0 +1,77 @@
+"""Telemetry of a run: truth and the flight software's estimate every 10 ms, and the errors.
+
+In: the station at a telemetry instant ``t_ns`` (true state q_BN, omega_BN_B [rad/s],
+r_N [m], v_N [m/s]; per-thruster thrust [N] at that instant; propellant [kg]; active
+faults) and the flight software's last estimate (bench.results.fsw_view). Out: one row of
+``telemetry.csv`` (columns in :func:`telemetry_columns`, units in their names), and the
+attitude error [deg], rate error [deg/s] and position error [m] from the manoeuvre's
+start on, kept for the run's metrics (bench.results.metrics).
+
+Errors: against the step target q_target_BN (rate error = |omega_BN_B|), or against the
+moving reference q_RN(t), omega_RN(t) of an MRP polynomial manoeuvre
+(bench.station.reference); the position error is the distance to the manoeuvre's
+r_target_N_m, else to the initial position. Thrust is the value at the instant, not a
+10 ms mean (pulses of a few ms fall between rows).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from bench.results.fsw_view import RAD_DEG, FswView, quat_error_deg
+from bench.results.writers import TelemetryWriter
+from bench.scenario import Scenario
+from bench.station.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
+from bench.station.station import Station
+
+TELEMETRY_PERIOD_NS = 10_000_000
+NS_PER_S = 1_000_000_000
+STATE_COLUMNS = ["t_s", "q0", "q1", "q2", "q3", "wx_rad_s", "wy_rad_s", "wz_rad_s", "rx_m",
+                 "ry_m", "rz_m", "vx_m_s", "vy_m_s", "vz_m_s", "att_err_deg", "rate_err_deg_s",
+                 "fsw_q0", "fsw_q1", "fsw_q2", "fsw_q3", "fsw_est_err_deg", "fsw_mode"]
+
+
+def telemetry_columns(n_thrusters: int) -> list[str]:
+    """The columns of telemetry.csv for a vehicle of ``n_thrusters``."""
+    return [*STATE_COLUMNS, *(f"thrust_T{k:02d}_N" for k in range(n_thrusters)),
+            "propellant_kg", "active_faults"]
+
+
+class Telemetry:
+    """telemetry.csv and the error histories the metrics need."""
+
+    def __init__(self, sc: Scenario, path: Path, n_thrusters: int, deferred: bool) -> None:
+        self.sc = sc
+        self.writer = TelemetryWriter(path, telemetry_columns(n_thrusters), deferred)
+        self._start_ns = sc.manoeuvre_start_s * NS_PER_S
+        self.t_s: list[float] = []
+        self.att_err_deg: list[float] = []
+        self.rate_err_deg_s: list[float] = []
+        self.pos_err_m: list[float] = []
+
+    def row(self, t_ns: int, station: Station, fsw: FswView) -> None:
+        """Sample the station at ``t_ns`` (a telemetry instant)."""
+        s = station.plant.state
+        sc = self.sc
+        if sc.reference.kind == KIND_STEP:
+            err = quat_error_deg(s[0:4], sc.q_target_BN)
+            rate_err = math.sqrt(s[4] ** 2 + s[5] ** 2 + s[6] ** 2) * RAD_DEG
+        else:  # a moving reference: errors w.r.t. q_RN(t), omega_RN(t)
+            q_ref, w_ref = reference(sc.reference, t_ns / NS_PER_S)
+            q_t = (s[0], s[1], s[2], s[3])
+            err = attitude_error_deg(q_t, q_ref)
+            dw = rate_error_B(q_t, (s[4], s[5], s[6]), q_ref, w_ref)
+            rate_err = math.sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2) * RAD_DEG
+        thr = station.plant.thrusters
+        row: list[float | int] = [t_ns / NS_PER_S, *s[0:4], *s[4:13], err, rate_err]
+        row += fsw.estimate_row()
+        row += [thr.valves[k].thrust_N(t_ns) for k in range(station.n_thr)]
+        row.append(thr.total_propellant_kg)
+        row.append(len(station.faults.active))
+        self.writer.row(row)
+        if t_ns >= self._start_ns:
+            self.t_s.append(t_ns / NS_PER_S)
+            self.att_err_deg.append(err)
+            self.rate_err_deg_s.append(rate_err)
+            self.pos_err_m.append(math.dist(s[7:10], sc.r_reference_N_m))
