@@ -41,7 +41,7 @@ from mypy_extensions import mypyc_attr
 from bench.results.run import Results
 from bench.results.telemetry import TELEMETRY_PERIOD_NS
 from bench.results.writers import write_summary
-from bench.scenario import Scenario
+from bench.scenario.spec import Scenario
 from bench.station.fault_book import Event
 from bench.station.plant import STEP_NS
 from bench.station.station import Pulse, Station

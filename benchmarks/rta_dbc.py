@@ -20,7 +20,7 @@ import json
 import sys
 
 from bench.operator.analysis.rta import messages_from_dbc, response_times
-from dbc import DBC_PATH, load_database
+from dbc.database import DBC_PATH, load_database
 
 BITRATES_BPS = (125_000, 500_000, 1_000_000)
 US_PER_S = 1_000_000

@@ -1,29 +1,23 @@
-"""thruster-hil interface control document: the DBC, its loader and end-to-end protection.
+"""thruster-hil's interface contract: the DBC, its facts, the codec, end-to-end protection.
 
-``thruster_hil.dbc`` beside this file is the single source of truth for every frame
-exchanged between flight software and bench: IDs, lengths, signals, scaling, ranges,
-senders and cycle times (``GenMsgCycleTime``). Both sides encode and decode only through
-:mod:`dbc.codec`, which reads that file with cantools.
+Modules: ``database`` (the DBC file and its loader), ``icd`` (the facts both sides read
+from it: IDs, periods, command layout, value tables), ``codec`` and ``layout`` (frames to
+physical values and back, the receive checks), ``e2e`` (CRC-8 and alive counter),
+``quaternion`` (the smallest-three encoding), ``schema`` (strict reading of configuration
+tables), ``errors`` (the project's error tree). ``load_database`` and ``DBC_PATH`` are
+importable from here too; they are loaded on first use, so that a pure module importing
+``dbc.icd`` pulls in no file-reading code.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
+import importlib
+from typing import Any
 
-import cantools
-from cantools.database.can import Database
-
-from dbc.errors import IcdError
-
-DBC_PATH = Path(__file__).with_name("thruster_hil.dbc")
+__all__ = ["DBC_PATH", "load_database"]
 
 
-def load_database(path: Path | str = DBC_PATH) -> Database:
-    """Load and return the CAN database at ``path`` (the project's ICD by default)."""
-    try:
-        db = cantools.database.load_file(str(path), strict=True)
-    except (OSError, cantools.database.UnsupportedDatabaseFormatError) as exc:
-        raise IcdError(f"{path}: cannot load DBC: {exc}") from exc
-    if not isinstance(db, Database):
-        raise IcdError(f"{path}: not a CAN database")
-    return db
+def __getattr__(name: str) -> Any:
+    if name not in __all__:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module("dbc.database"), name)

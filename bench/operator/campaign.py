@@ -27,7 +27,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-from bench.scenario import load_scenario
+from bench.scenario.load import load_scenario
 from dbc.bus import LOCKSTEP_SPIN_ENV, available_cpus
 from dbc.errors import ConfigError, RunError
 

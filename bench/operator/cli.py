@@ -97,7 +97,7 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         run_scenario,
         scenario_warnings,
     )
-    from bench.scenario import load_scenario
+    from bench.scenario.load import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
     for w in scenario_warnings(sc):  # said before the run too, not only in its summary

@@ -15,9 +15,10 @@ from dataclasses import dataclass
 
 import can
 
-from dbc import e2e, load_database
+from dbc import e2e
 from dbc.bus import open_bus
 from dbc.codec import Encoder, FrameChecker
+from dbc.database import load_database
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 from dbc.icd import Icd
 

@@ -38,10 +38,10 @@ from bench.operator.plausibility import mass_warnings
 from bench.results.counts import frame_table, merge_counts, zero_unheard
 from bench.results.metrics import pointing_metrics
 from bench.results.writers import write_summary
-from bench.scenario import Scenario
-from dbc import load_database
+from bench.scenario.spec import Scenario
 from dbc.bus import available_cpus, lockstep_spin_s, mode_options, open_bus
 from dbc.codec import cycle_time_ns
+from dbc.database import load_database
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 from dbc.hilbus import MEMBER_STALL_S
 from dbc.icd import Icd

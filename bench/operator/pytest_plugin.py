@@ -342,7 +342,7 @@ class HilRunner:
     def _run(self, opts: HilRunOptions) -> tuple[Path, dict[str, Any], str]:
         """Run once; returns (run folder, summary, bus spec used)."""
         from bench.operator.orchestrator import RunOptions, run_scenario
-        from bench.scenario import load_scenario
+        from bench.scenario.load import load_scenario
 
         sc = load_scenario(opts.scenario, list(opts.overrides))
         private = opts.bus is None

@@ -24,7 +24,7 @@ from bench.results.metrics import latency_summary
 from bench.results.summary import expectations_and_metrics
 from bench.results.telemetry import Telemetry
 from bench.results.writers import CHAIN_COLUMNS, PULSE_COLUMNS, TelemetryWriter
-from bench.scenario import Scenario
+from bench.scenario.spec import Scenario
 from bench.station.station import Pulse, Station
 from bench.wire.receipt import Receipt
 from bench.wire.wire import Wire

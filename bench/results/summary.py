@@ -20,7 +20,7 @@ from bench.results.metrics import (
     settling_time_s,
 )
 from bench.results.telemetry import Telemetry
-from bench.scenario import Scenario
+from bench.scenario.spec import Scenario
 
 
 def expectations_and_metrics(sc: Scenario, tel: Telemetry) -> dict[str, Any]:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from bench.results.fsw_view import RAD_DEG, FswView, quat_error_deg
 from bench.results.writers import TelemetryWriter
-from bench.scenario import Scenario
+from bench.scenario.spec import Scenario
 from bench.station.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
 from bench.station.station import Station
 

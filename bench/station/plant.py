@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from bench.scenario import CaptureSpec, Scenario
+from bench.scenario.spec import CaptureSpec, Scenario
 from bench.station.dynamics.capture import capture_state
 from bench.station.dynamics.hcw import HcwParams, HcwTranslation
 from bench.station.dynamics.rigid_body import MassProperties, make_state, rk4_step

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from bench.scenario import Scenario
+from bench.scenario.spec import Scenario
 from bench.station.fault_book import Event, FaultBook
 from bench.station.plant import STEP_NS, Plant
 from bench.station.sampling import SensorFrames, Signals

@@ -5,8 +5,9 @@ from __future__ import annotations
 import can
 import pytest
 
-from dbc import e2e, load_database
+from dbc import e2e
 from dbc.codec import Encoder, FrameChecker, Reject, data_id
+from dbc.database import load_database
 from dbc.errors import IcdError
 
 IMU = {"Valid": 1, "RateX": 0.1, "RateY": -0.2, "RateZ": 0.00002}

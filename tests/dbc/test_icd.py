@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from dbc import load_database
 from dbc.codec import Encoder, FrameChecker, data_id
+from dbc.database import load_database
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 
 ARCSEC_RAD = math.pi / 180 / 3600

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from dbc import load_database
+from dbc.database import load_database
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "icd.md"
 ROW = re.compile(r"^\| 0x([0-9A-F]{3}) \| (\w+) \| (\w+) → [^|]+\| (\d+ ms|event) \|")

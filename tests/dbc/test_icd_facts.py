@@ -5,7 +5,7 @@ from __future__ import annotations
 import cantools
 import pytest
 
-from dbc import DBC_PATH, load_database
+from dbc.database import DBC_PATH, load_database
 from dbc.errors import IcdError
 from dbc.icd import BENCH, FSW, Icd
 

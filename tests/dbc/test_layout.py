@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 from cantools.database.can import Database, Message
 
-from dbc import e2e, load_database
+from dbc import e2e
 from dbc.codec import Encoder, data_id
+from dbc.database import load_database
 from dbc.errors import IcdError
 from dbc.layout import FrameLayout
 

@@ -10,7 +10,7 @@ import can
 import pytest
 
 from bench.wire.timing import failed_attempt_bits, wire_time_ns
-from dbc import load_database
+from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
 
 pytestmark = pytest.mark.slow

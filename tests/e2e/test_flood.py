@@ -8,7 +8,7 @@ from pathlib import Path
 import can
 import pytest
 
-from dbc import load_database
+from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, flood, running, unique_bus
 
 pytestmark = pytest.mark.slow

@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from bench.operator.inject import FaultCommand, cansend_string, inject
-from dbc import load_database
 from dbc.codec import FrameChecker
+from dbc.database import load_database
 from dbc.errors import RefusedConfigError
 from tests.e2e.conftest import QUICKSTART, running, unique_bus
 

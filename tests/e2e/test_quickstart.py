@@ -8,7 +8,8 @@ from pathlib import Path
 import can
 import pytest
 
-from dbc import e2e, load_database
+from dbc import e2e
+from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, Run, run_cli, unique_bus
 
 pytestmark = pytest.mark.slow

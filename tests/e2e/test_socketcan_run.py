@@ -7,7 +7,7 @@ from pathlib import Path
 import can
 import pytest
 
-from dbc import load_database
+from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, run_cli
 
 pytestmark = pytest.mark.socketcan

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from bench.scenario import load_scenario
+from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError
 from flight_sw.config import build_computer
 from flight_sw.control.position_pd import PositionPd

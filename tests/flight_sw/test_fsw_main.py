@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from bench.scenario import load_scenario
+from bench.scenario.load import load_scenario
 from flight_sw.__main__ import EXIT_BAD_INPUT, main
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"

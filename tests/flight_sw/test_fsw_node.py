@@ -18,9 +18,9 @@ from typing import Any
 import can
 import pytest
 
-from bench.scenario import load_scenario
-from dbc import load_database
+from bench.scenario.load import load_scenario
 from dbc.codec import Encoder, FrameChecker, cycle_time_ns
+from dbc.database import load_database
 from dbc.quaternion import pack_quaternion
 from flight_sw.config import build_computer
 from flight_sw.modes import FdirFlag, Mode, SensorFlag

@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-from bench.scenario import load_scenario
+from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError
 from flight_sw.computer import DEFAULT_CYCLE_PHASE_NS
 from flight_sw.config import build_computer

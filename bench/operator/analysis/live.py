@@ -34,8 +34,8 @@ import can
 from bench.operator.analysis.defaults import DEFAULT_FIRST_FRAME_TIMEOUT_S
 from bench.operator.analysis.timing import FrameTable, RunTiming, TimingOptions, dbc_bitrate_bps
 from bench.wire.timing import frame_bits
-from dbc import load_database
 from dbc.bus import open_bus
+from dbc.database import load_database
 from dbc.e2e import COUNTER_BYTE, COUNTER_MASK
 from dbc.errors import ConfigError, RunError
 from dbc.hilbus import tx_timestamp_of

@@ -99,8 +99,8 @@ from bench.operator.analysis.reception import (
 from bench.operator.analysis.rta import messages_from_dbc, response_times
 from bench.results.writers import CHAIN_COLUMNS
 from bench.wire.trace import FRAME_COLUMNS
-from dbc import load_database
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps
+from dbc.database import load_database
 from dbc.e2e import COUNTER_MODULUS
 from dbc.errors import ConfigError, IcdError, RunError
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from bench.operator.authority import authority_warnings, effectiveness, unreached_axes
-from bench.scenario import load_scenario
+from bench.scenario.load import load_scenario
 
 QUICKSTART = Path(__file__).resolve().parents[3] / "scenarios" / "quickstart.toml"
 

@@ -9,7 +9,7 @@ import pytest
 
 from bench.operator.inject import KIND_CODES, FaultCommand, cansend_string
 from bench.station.faults import fault_from_command
-from dbc import load_database
+from dbc.database import load_database
 from dbc.errors import ConfigError
 from dbc.icd import Icd
 

@@ -10,7 +10,7 @@ import pytest
 
 from bench.operator import orchestrator
 from bench.operator.orchestrator import duration_warnings
-from bench.scenario import load_scenario
+from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError, RefusedConfigError
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"

@@ -8,7 +8,7 @@ import pytest
 
 from bench.operator.orchestrator import scenario_warnings
 from bench.operator.plausibility import MAX_RATIO, MIN_RATIO, mass_warnings
-from bench.scenario import load_scenario
+from bench.scenario.load import load_scenario
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 UNIT = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))

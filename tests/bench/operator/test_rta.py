@@ -16,7 +16,7 @@ from bench.operator.analysis.rta import (
     response_times,
 )
 from bench.wire.timing import NS_PER_S, BusArbiter, frame_bits_worst_case
-from dbc import load_database
+from dbc.database import load_database
 from dbc.errors import ConfigError
 
 BITRATE_125K = 125_000

@@ -26,7 +26,7 @@ from bench.operator.analysis.timing import (
 )
 from bench.results.writers import CHAIN_COLUMNS
 from bench.wire.trace import FRAME_COLUMNS
-from dbc import load_database
+from dbc.database import load_database
 from dbc.errors import ConfigError, RunError
 from dbc.hilbus import HilMessage
 

@@ -9,8 +9,9 @@ import pytest
 
 from bench.station.faults import FaultSpec
 from bench.wire.receipt import Receipt
-from dbc import e2e, load_database
+from dbc import e2e
 from dbc.codec import Encoder, FrameChecker, Reject
+from dbc.database import load_database
 from dbc.icd import BENCH, FSW, OPERATOR, Icd
 
 DB = load_database()

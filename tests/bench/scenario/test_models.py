@@ -10,7 +10,8 @@ from typing import Any
 
 import pytest
 
-from bench.scenario import load_scenario, parse_scenario
+from bench.scenario.load import load_scenario
+from bench.scenario.parse import parse_scenario
 from bench.station.dynamics.hcw import hcw_closed_form, mean_motion_rad_s
 from bench.station.dynamics.rigid_body import angular_momentum_N
 from bench.station.plant import NS_PER_S, STEP_NS, Plant
@@ -21,7 +22,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 QUICKSTART = SCENARIOS / "quickstart.toml"
 FDIR16 = SCENARIOS / "fdir_16thr.toml"
 IMU_PERIOD_NS = 10_000_000

@@ -10,9 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from bench.scenario import apply_overrides, load_scenario, parse_scenario, quat_from_euler_zyx
-from dbc import load_database
+from bench.scenario.load import apply_overrides, load_scenario
+from bench.scenario.parse import parse_scenario, quat_from_euler_zyx
 from dbc.codec import bitrate_range_bps
+from dbc.database import load_database
 from dbc.errors import ConfigError
 
 if sys.version_info >= (3, 11):
@@ -20,7 +21,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
+QUICKSTART = Path(__file__).resolve().parents[3] / "scenarios" / "quickstart.toml"
 SEED003_INERTIA = (15.95, 72.19, 72.19)
 SEED003_THRUST_N = 15.0
 N_FUZZ = 300

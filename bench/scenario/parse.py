@@ -1,269 +1,57 @@
-"""Scenario files (TOML) -> a validated, frozen :class:`Scenario`.
+"""Scenario TOML data -> a validated :class:`~bench.scenario.spec.Scenario`.
 
-A scenario says everything about one run: vehicle (actual and nominal mass properties),
-thrusters (a named layout or an explicit list, valve dynamics), sensors, bus, initial
-state, manoeuvre, the flight-software configuration (passed to the flight-software
-process as data, validated there), scheduled faults and expectations. Every bad field
-raises :class:`dbc.errors.ConfigError` naming the file, the dotted key, the value and what
-was expected; unknown keys are errors too. Nothing in a scenario is ever evaluated.
-
-Units are in the key names (``_s``, ``_m``, ``_deg``, ``_N`` ...). Angles are converted to
-radians here; quaternions are scalar-first q_BN.
+Every bad field raises :class:`dbc.errors.ConfigError` naming the file, the dotted key,
+the value and what was expected; unknown keys are errors too (:class:`dbc.schema.Table`).
+Nothing in a scenario is ever evaluated. Angles in degrees in the file become radians
+here; rates per hour become per second; sensor ranges default to, and may not exceed,
+the DBC's signal ranges; the number of thrusters to what the command frames address.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import re
-import sys
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from cantools.database.can import Database
 
+from bench.scenario.spec import (
+    EVENT_KINDS,
+    TRANSLATIONS,
+    VALVE_MODELS,
+    AccelSpec,
+    BusSpecCfg,
+    CaptureSpec,
+    DynamicsSpec,
+    EnvironmentSpec,
+    Expectations,
+    GyroSpec,
+    MassSpec,
+    Quat,
+    RelNavSpec,
+    Scenario,
+    StarTrackerSpec,
+    ThrusterSpec,
+    ValveSpec,
+)
 from bench.station.dynamics.hcw import SEED000_ORBIT_RADIUS_M
 from bench.station.dynamics.rigid_body import MassProperties
 from bench.station.environment.disturbance import FORCE_FRAMES, DisturbanceParams, Sinusoid
-from bench.station.faults import FaultSpec, parse_faults
+from bench.station.faults import parse_faults
 from bench.station.reference import KIND_STEP, KINDS, ReferenceParams, reference
 from bench.station.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
-from dbc import load_database
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps, bitrate_range_bps
+from dbc.database import load_database
 from dbc.errors import ConfigError
+from dbc.icd import Icd
 from dbc.schema import Table
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 DEG_RAD = math.pi / 180.0
 # A target Euler angle beyond a full turn is no attitude anyone writes: a unit slip.
 EULER_LIMIT_DEG = 360.0
 SQRT_HOUR_S = 60.0  # sqrt(3600 s)
+S_PER_H = 3600.0
 UNIT_NORM_TOL = 1e-6
-MODES = ("lockstep", "realtime")
-TRANSLATIONS = ("inertial", "hcw")
-FSW_TABLE = "flight_sw"  # the table passed through to the flight software
-"""[dynamics] translation: inertial (default) or HCW relative motion (station.dynamics.hcw)."""
-VALVE_MODELS = ("on_off", "throttled")
-"""[thrusters] valve_model: on_off (station.valves.valve), throttled (station.valves.throttled)."""
-EVENT_KINDS = ("capture",)
-"""[[events]] kinds: capture (bench.station.dynamics.capture)."""
-MAX_THRUSTERS = 16
-
-Vec3 = tuple[float, float, float]
-Quat = tuple[float, float, float, float]
-
-
-@dataclass(frozen=True)
-class MassSpec:
-    mass_kg: float
-    inertia_B_kgm2: tuple[Vec3, Vec3, Vec3]
-
-
-@dataclass(frozen=True)
-class ThrusterSpec:
-    r_thr_B_m: Vec3
-    d_thr_B: Vec3
-    max_thrust_N: float | None = None
-    """This thruster's maximum thrust [N]; None = the valve's ``max_thrust_N``."""
-
-
-@dataclass(frozen=True)
-class ValveSpec:
-    max_thrust_N: float
-    isp_s: float
-    open_delay_s: float
-    close_delay_s: float
-    rise_tau_s: float
-    tail_tau_s: float
-    min_on_s: float
-    model: str = "on_off"
-
-
-@dataclass(frozen=True)
-class DynamicsSpec:
-    """[dynamics]: translation model and the leader's circular orbit radius [m]."""
-
-    translation: str = "inertial"
-    orbit_radius_m: float = SEED000_ORBIT_RADIUS_M
-
-
-@dataclass(frozen=True)
-class EnvironmentSpec:
-    """[environment]: gravity-gradient torque on/off about a circular orbit of radius [m]."""
-
-    gravity_gradient: bool = False
-    orbit_radius_m: float = SEED000_ORBIT_RADIUS_M
-
-
-@dataclass(frozen=True)
-class CaptureSpec:
-    """A [[events]] capture: new mass [kg], inertia about the new CoM [kg m^2], CoM [m]."""
-
-    t_s: float
-    mass: MassSpec
-    com_B_m: Vec3
-
-    def record(self) -> dict[str, Any]:
-        """The event as logged (events.jsonl, summary.json)."""
-        return {
-            "kind": "capture",
-            "t_s": self.t_s,
-            "mass_kg": self.mass.mass_kg,
-            "inertia_B_kgm2": [list(r) for r in self.mass.inertia_B_kgm2],
-            "com_B_m": list(self.com_B_m),
-        }
-
-
-@dataclass(frozen=True)
-class GyroSpec:
-    arw_rad_sqrt_s: float
-    bias_rad_s: Vec3
-    bias_rw_rad_s_sqrt_s: float
-    lsb_rad_s: float
-    range_rad_s: float
-
-
-@dataclass(frozen=True)
-class AccelSpec:
-    vrw_m_s_sqrt_s: float
-    bias_m_s2: Vec3
-    lsb_m_s2: float
-    range_m_s2: float
-
-
-@dataclass(frozen=True)
-class StarTrackerSpec:
-    noise_cross_arcsec: float
-    noise_about_arcsec: float
-    boresight_B: Vec3
-
-
-@dataclass(frozen=True)
-class RelNavSpec:
-    noise_pos_m: float
-    noise_vel_m_s: float
-
-
-@dataclass(frozen=True)
-class BusSpecCfg:
-    bitrate_bps: int
-    fsw_response_delay_s: float
-    stall_timeout_s: float
-    startup_timeout_s: float
-
-
-@dataclass(frozen=True)
-class Expectations:
-    settling_band_deg: float
-    settling_time_s_max: float | None
-    steady_state_attitude_error_deg_max: float | None
-    steady_state_rate_error_deg_s_max: float | None
-    steady_state_window_s: float
-    steady_state_position_error_m_max: float | None = None
-    final_position_error_m_max: float | None = None
-    position_band_m: float | None = None
-    position_settling_time_s_max: float | None = None
-    rate_settling_band_deg_s: float | None = None
-    rate_settling_time_s_max: float | None = None
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """A validated scenario. ``flight_sw`` is handed verbatim to the flight software."""
-
-    path: str
-    name: str
-    description: str
-    duration_s: float
-    seed: int
-    actual: MassSpec
-    nominal: MassSpec
-    thrusters: tuple[ThrusterSpec, ...]
-    valve: ValveSpec
-    gyro: GyroSpec
-    accel: AccelSpec
-    star_tracker: StarTrackerSpec
-    rel_nav: RelNavSpec | None
-    bus: BusSpecCfg
-    q0_BN: Quat
-    omega0_BN_B_rad_s: Vec3
-    r0_N_m: Vec3
-    v0_N_m_s: Vec3
-    q_target_BN: Quat
-    manoeuvre_start_s: float
-    flight_sw: dict[str, Any]
-    faults: tuple[FaultSpec, ...]
-    expectations: Expectations
-    raw: dict[str, Any] = field(repr=False, compare=False, default_factory=dict)
-    overrides: tuple[str, ...] = ()
-    dynamics: DynamicsSpec = DynamicsSpec()
-    environment: EnvironmentSpec = EnvironmentSpec()
-    disturbance: DisturbanceParams | None = None
-    events: tuple[CaptureSpec, ...] = ()
-    reference: ReferenceParams = field(default_factory=ReferenceParams)
-    r_target_N_m: Vec3 | None = None
-    """[manoeuvre] r_target_N_m: reference position of the position metrics (None = r0)."""
-
-    @property
-    def max_thrusts_N(self) -> tuple[float, ...]:
-        """Maximum thrust of every thruster [N] (its own, else the valve's)."""
-        v = self.valve.max_thrust_N
-        return tuple(v if t.max_thrust_N is None else t.max_thrust_N for t in self.thrusters)
-
-    @property
-    def r_reference_N_m(self) -> Vec3:
-        """Reference position of the position metrics [m] (target, else the initial one)."""
-        return self.r0_N_m if self.r_target_N_m is None else self.r_target_N_m
-
-    def fsw_config(self) -> dict[str, Any]:
-        """The flight-software configuration file content (nominal vehicle + [flight_sw]).
-
-        New keys appear only when the scenario uses the feature, so the configuration of
-        a scenario without them is unchanged: per-thruster ``max_thrust_N`` (when the
-        thrusters' maxima differ from the valve's; the top-level one is their maximum),
-        ``valve_model`` (when throttled; ``min_on_s`` is then 0), and in ``manoeuvre``
-        ``kind`` + ``mrp_coefficients`` (MRP polynomial; ``q_target_BN`` is then the
-        reference at the end of the run) and ``r_target_N_m`` (when given).
-        """
-        maxima = self.max_thrusts_N
-        per_thruster = any(m != self.valve.max_thrust_N for m in maxima)
-        thrusters: list[dict[str, Any]] = []
-        for t, m in zip(self.thrusters, maxima, strict=True):
-            entry: dict[str, Any] = {"r_thr_B_m": list(t.r_thr_B_m), "d_thr_B": list(t.d_thr_B)}
-            if per_thruster:
-                entry["max_thrust_N"] = m
-            thrusters.append(entry)
-        throttled = self.valve.model != "on_off"
-        manoeuvre: dict[str, Any] = {
-            "q_target_BN": list(self.q_target_BN),
-            "t_start_s": self.manoeuvre_start_s,
-        }
-        if self.reference.kind != KIND_STEP:
-            manoeuvre["kind"] = self.reference.kind
-            manoeuvre["mrp_coefficients"] = [list(c) for c in self.reference.mrp_coefficients]
-        if self.r_target_N_m is not None:
-            manoeuvre["r_target_N_m"] = list(self.r_target_N_m)
-        cfg: dict[str, Any] = {
-            "source": override_source(self.path, [
-                o for o in self.overrides if o.startswith(FSW_TABLE + ".")]),
-            "vehicle": {
-                "mass_kg": self.nominal.mass_kg,
-                "inertia_B_kgm2": [list(r) for r in self.nominal.inertia_B_kgm2],
-            },
-            "thrusters": thrusters,
-            "max_thrust_N": max(maxima),
-            "min_on_s": 0.0 if throttled else self.valve.min_on_s,
-            "manoeuvre": manoeuvre,
-            "flight_sw": self.flight_sw,
-        }
-        if throttled:
-            cfg["valve_model"] = self.valve.model
-        return cfg
 
 
 def quat_from_euler_zyx(yaw_rad: float, pitch_rad: float, roll_rad: float) -> Quat:
@@ -336,7 +124,8 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
                 dataclasses.replace(g, max_thrust_N=m)
                 for g, m in zip(geo, default_max, strict=True)
             ]
-    if len(geo) > MAX_THRUSTERS:
+    max_thrusters = Icd.from_database(load_database()).max_thrusters
+    if len(geo) > max_thrusters:
         raise t.error("list", len(geo), "at most 16 thrusters (THR_CMD_0..3 carry 16)")
     if t.has("max_thrust_per_thruster_N"):
         if layout == "explicit":
@@ -383,7 +172,7 @@ def _sensors(
     g = t.table("gyro")
     gyro = GyroSpec(
         arw_rad_sqrt_s=g.number("arw_deg_sqrt_h", lo=0.0) * DEG_RAD / SQRT_HOUR_S,
-        bias_rad_s=tuple(x * DEG_RAD / 3600.0 for x in g.vector("bias_deg_h", 3)),  # type: ignore[arg-type]
+        bias_rad_s=tuple(x * DEG_RAD / S_PER_H for x in g.vector("bias_deg_h", 3)),  # type: ignore[arg-type]
         bias_rw_rad_s_sqrt_s=g.number("bias_rw_deg_h_sqrt_h", lo=0.0)
         * DEG_RAD
         / 3600.0
@@ -638,90 +427,3 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     )
 
 
-def apply_overrides(data: dict[str, Any], overrides: list[str], source: str) -> None:
-    """Apply ``KEY=VALUE`` overrides (dotted keys, TOML values) to parsed scenario data in place.
-
-    ``bus.bitrate_bps=125000``, ``flight_sw.modulator.km=10.0``, ``manoeuvre.t_start_s=2``;
-    an element of an array of tables by its index: ``thrusters.list[0].max_thrust_N=5.0``,
-    ``faults[1].t_s=30``. A value that is not valid TOML is taken as a string. Errors name
-    the override.
-    """
-    for item in overrides:
-        key, sep, text = item.partition("=")
-        if not sep or not key:
-            raise ConfigError(source, "--set", item, "KEY=VALUE with a dotted KEY")
-        try:
-            value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
-            value = text
-        table = data
-        parts = [_override_part(source, key, p) for p in key.split(".")]
-        for name, index in parts[:-1]:
-            nxt = table.setdefault(name, {} if index is None else [])
-            if index is not None:
-                if not isinstance(nxt, list) or not 0 <= index < len(nxt):
-                    size = len(nxt) if isinstance(nxt, list) else 0
-                    raise ConfigError(source, key, item, f"{name!r} to be an array of tables "
-                                      f"with an element {index} (it has {size})")
-                nxt = nxt[index]
-            if not isinstance(nxt, dict):
-                raise ConfigError(source, key, item, f"{name!r} to be a table")
-            table = nxt
-        name, index = parts[-1]
-        if index is not None:
-            raise ConfigError(source, key, item, "a key inside the element (e.g. "
-                              f"{name}[{index}].t_s), or the whole array: {name}=[...]")
-        table[name] = value
-
-
-_OVERRIDE_PART = re.compile(r"([A-Za-z0-9_-]+)(?:\[(\d+)\])?")
-
-
-def _override_part(source: str, key: str, part: str) -> tuple[str, int | None]:
-    """``name`` or ``name[i]`` of a dotted override key."""
-    m = _OVERRIDE_PART.fullmatch(part)
-    if m is None:
-        raise ConfigError(source, "--set", key, "a dotted KEY of names, each optionally "
-                          "indexed as name[i]")
-    return m.group(1), None if m.group(2) is None else int(m.group(2))
-
-
-def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:
-    """Read and validate the scenario file at ``path``, after ``KEY=VALUE`` overrides."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError(
-            str(p), "<file>", str(p), f"a readable scenario file ({exc.strerror})"
-        ) from exc
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(str(p), "<syntax>", str(exc), "valid TOML") from exc
-    apply_overrides(data, overrides or [], str(p))
-    try:
-        sc = parse_scenario(data, str(p))
-    except ConfigError as exc:
-        item = _override_of(exc.key, overrides or [])
-        if item is None:
-            raise
-        raise ConfigError(override_source(str(p), [item]), exc.key, exc.value,
-                          exc.expected) from exc
-    return dataclasses.replace(sc, overrides=tuple(overrides or ()))
-
-
-def override_source(path: str, items: list[str]) -> str:
-    """Where a value came from: the file, or the ``--set`` items applied to it."""
-    if not items:
-        return path
-    return "command line " + " ".join(f"--set {i}" for i in items) + f" (on {path})"
-
-
-def _override_of(key: str, overrides: list[str]) -> str | None:
-    """The ``--set`` item that wrote ``key`` (or a table above or below it), if any."""
-    for item in reversed(overrides):  # the last one wins, as applied
-        k = item.partition("=")[0]
-        if key == k or key.startswith(k + ".") or k.startswith(key + "."):
-            return item
-    return None

@@ -1,0 +1,249 @@
+"""The validated scenario: frozen records of everything one run needs.
+
+A :class:`Scenario` says everything about one run: vehicle (actual and nominal mass
+properties), thrusters (geometry, per-thruster maximum thrust, valve dynamics), sensors,
+bus, initial state, manoeuvre, the flight-software configuration (handed to the
+flight-software process as data), scheduled faults and expectations. Built by
+:func:`bench.scenario.parse.parse_scenario` from TOML data (file reading and ``--set``
+overrides: :mod:`bench.scenario.load`); read by every room of the bench.
+
+Units are in the field names (``_s``, ``_m``, ``_N`` ...); angles are radians;
+quaternions are scalar-first q_BN. Pure data: no file, clock or socket.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from bench.station.dynamics.hcw import SEED000_ORBIT_RADIUS_M
+from bench.station.environment.disturbance import DisturbanceParams
+from bench.station.faults import FaultSpec
+from bench.station.reference import KIND_STEP, ReferenceParams
+
+FSW_TABLE = "flight_sw"  # the table passed through to the flight software
+TRANSLATIONS = ("inertial", "hcw")
+"""[dynamics] translation: inertial (default) or HCW relative motion (station.dynamics.hcw)."""
+VALVE_MODELS = ("on_off", "throttled")
+"""[thrusters] valve_model: on_off (station.valves.valve), throttled (station.valves.throttled)."""
+EVENT_KINDS = ("capture",)
+"""[[events]] kinds: capture (bench.station.dynamics.capture)."""
+
+Vec3 = tuple[float, float, float]
+Quat = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class MassSpec:
+    mass_kg: float
+    inertia_B_kgm2: tuple[Vec3, Vec3, Vec3]
+
+
+@dataclass(frozen=True)
+class ThrusterSpec:
+    r_thr_B_m: Vec3
+    d_thr_B: Vec3
+    max_thrust_N: float | None = None
+    """This thruster's maximum thrust [N]; None = the valve's ``max_thrust_N``."""
+
+
+@dataclass(frozen=True)
+class ValveSpec:
+    max_thrust_N: float
+    isp_s: float
+    open_delay_s: float
+    close_delay_s: float
+    rise_tau_s: float
+    tail_tau_s: float
+    min_on_s: float
+    model: str = "on_off"
+
+
+@dataclass(frozen=True)
+class DynamicsSpec:
+    """[dynamics]: translation model and the leader's circular orbit radius [m]."""
+
+    translation: str = "inertial"
+    orbit_radius_m: float = SEED000_ORBIT_RADIUS_M
+
+
+@dataclass(frozen=True)
+class EnvironmentSpec:
+    """[environment]: gravity-gradient torque on/off about a circular orbit of radius [m]."""
+
+    gravity_gradient: bool = False
+    orbit_radius_m: float = SEED000_ORBIT_RADIUS_M
+
+
+@dataclass(frozen=True)
+class CaptureSpec:
+    """A [[events]] capture: new mass [kg], inertia about the new CoM [kg m^2], CoM [m]."""
+
+    t_s: float
+    mass: MassSpec
+    com_B_m: Vec3
+
+    def record(self) -> dict[str, Any]:
+        """The event as logged (events.jsonl, summary.json)."""
+        return {
+            "kind": "capture",
+            "t_s": self.t_s,
+            "mass_kg": self.mass.mass_kg,
+            "inertia_B_kgm2": [list(r) for r in self.mass.inertia_B_kgm2],
+            "com_B_m": list(self.com_B_m),
+        }
+
+
+@dataclass(frozen=True)
+class GyroSpec:
+    arw_rad_sqrt_s: float
+    bias_rad_s: Vec3
+    bias_rw_rad_s_sqrt_s: float
+    lsb_rad_s: float
+    range_rad_s: float
+
+
+@dataclass(frozen=True)
+class AccelSpec:
+    vrw_m_s_sqrt_s: float
+    bias_m_s2: Vec3
+    lsb_m_s2: float
+    range_m_s2: float
+
+
+@dataclass(frozen=True)
+class StarTrackerSpec:
+    noise_cross_arcsec: float
+    noise_about_arcsec: float
+    boresight_B: Vec3
+
+
+@dataclass(frozen=True)
+class RelNavSpec:
+    noise_pos_m: float
+    noise_vel_m_s: float
+
+
+@dataclass(frozen=True)
+class BusSpecCfg:
+    bitrate_bps: int
+    fsw_response_delay_s: float
+    stall_timeout_s: float
+    startup_timeout_s: float
+
+
+@dataclass(frozen=True)
+class Expectations:
+    settling_band_deg: float
+    settling_time_s_max: float | None
+    steady_state_attitude_error_deg_max: float | None
+    steady_state_rate_error_deg_s_max: float | None
+    steady_state_window_s: float
+    steady_state_position_error_m_max: float | None = None
+    final_position_error_m_max: float | None = None
+    position_band_m: float | None = None
+    position_settling_time_s_max: float | None = None
+    rate_settling_band_deg_s: float | None = None
+    rate_settling_time_s_max: float | None = None
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario. ``flight_sw`` is handed verbatim to the flight software."""
+
+    path: str
+    name: str
+    description: str
+    duration_s: float
+    seed: int
+    actual: MassSpec
+    nominal: MassSpec
+    thrusters: tuple[ThrusterSpec, ...]
+    valve: ValveSpec
+    gyro: GyroSpec
+    accel: AccelSpec
+    star_tracker: StarTrackerSpec
+    rel_nav: RelNavSpec | None
+    bus: BusSpecCfg
+    q0_BN: Quat
+    omega0_BN_B_rad_s: Vec3
+    r0_N_m: Vec3
+    v0_N_m_s: Vec3
+    q_target_BN: Quat
+    manoeuvre_start_s: float
+    flight_sw: dict[str, Any]
+    faults: tuple[FaultSpec, ...]
+    expectations: Expectations
+    raw: dict[str, Any] = field(repr=False, compare=False, default_factory=dict)
+    overrides: tuple[str, ...] = ()
+    dynamics: DynamicsSpec = DynamicsSpec()
+    environment: EnvironmentSpec = EnvironmentSpec()
+    disturbance: DisturbanceParams | None = None
+    events: tuple[CaptureSpec, ...] = ()
+    reference: ReferenceParams = field(default_factory=ReferenceParams)
+    r_target_N_m: Vec3 | None = None
+    """[manoeuvre] r_target_N_m: reference position of the position metrics (None = r0)."""
+
+    @property
+    def max_thrusts_N(self) -> tuple[float, ...]:
+        """Maximum thrust of every thruster [N] (its own, else the valve's)."""
+        v = self.valve.max_thrust_N
+        return tuple(v if t.max_thrust_N is None else t.max_thrust_N for t in self.thrusters)
+
+    @property
+    def r_reference_N_m(self) -> Vec3:
+        """Reference position of the position metrics [m] (target, else the initial one)."""
+        return self.r0_N_m if self.r_target_N_m is None else self.r_target_N_m
+
+    def fsw_config(self) -> dict[str, Any]:
+        """The flight-software configuration file content (nominal vehicle + [flight_sw]).
+
+        New keys appear only when the scenario uses the feature, so the configuration of
+        a scenario without them is unchanged: per-thruster ``max_thrust_N`` (when the
+        thrusters' maxima differ from the valve's; the top-level one is their maximum),
+        ``valve_model`` (when throttled; ``min_on_s`` is then 0), and in ``manoeuvre``
+        ``kind`` + ``mrp_coefficients`` (MRP polynomial; ``q_target_BN`` is then the
+        reference at the end of the run) and ``r_target_N_m`` (when given).
+        """
+        maxima = self.max_thrusts_N
+        per_thruster = any(m != self.valve.max_thrust_N for m in maxima)
+        thrusters: list[dict[str, Any]] = []
+        for t, m in zip(self.thrusters, maxima, strict=True):
+            entry: dict[str, Any] = {"r_thr_B_m": list(t.r_thr_B_m), "d_thr_B": list(t.d_thr_B)}
+            if per_thruster:
+                entry["max_thrust_N"] = m
+            thrusters.append(entry)
+        throttled = self.valve.model != "on_off"
+        manoeuvre: dict[str, Any] = {
+            "q_target_BN": list(self.q_target_BN),
+            "t_start_s": self.manoeuvre_start_s,
+        }
+        if self.reference.kind != KIND_STEP:
+            manoeuvre["kind"] = self.reference.kind
+            manoeuvre["mrp_coefficients"] = [list(c) for c in self.reference.mrp_coefficients]
+        if self.r_target_N_m is not None:
+            manoeuvre["r_target_N_m"] = list(self.r_target_N_m)
+        cfg: dict[str, Any] = {
+            "source": override_source(self.path, [
+                o for o in self.overrides if o.startswith(FSW_TABLE + ".")]),
+            "vehicle": {
+                "mass_kg": self.nominal.mass_kg,
+                "inertia_B_kgm2": [list(r) for r in self.nominal.inertia_B_kgm2],
+            },
+            "thrusters": thrusters,
+            "max_thrust_N": max(maxima),
+            "min_on_s": 0.0 if throttled else self.valve.min_on_s,
+            "manoeuvre": manoeuvre,
+            "flight_sw": self.flight_sw,
+        }
+        if throttled:
+            cfg["valve_model"] = self.valve.model
+        return cfg
+
+
+
+def override_source(path: str, items: list[str]) -> str:
+    """Where a value came from: the file, or the ``--set`` items applied to it."""
+    if not items:
+        return path
+    return "command line " + " ".join(f"--set {i}" for i in items) + f" (on {path})"
