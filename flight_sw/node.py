@@ -1,19 +1,25 @@
 """The flight-software process: CAN port and cycle scheduler around :class:`FlightComputer`.
 
-Frames in (checked on receipt by :class:`dbc.codec.FrameChecker`: ID, DLC, CRC, alive
-counter, range; freshness of SYNC by its cycle number): SYNC, IMU_RATE, IMU_ACCEL,
-STR_QUAT, NAV_POS, NAV_VEL, THR_STATUS, BENCH_STATUS. Frames out: FSW_STATUS (also the boot
-heartbeat), FSW_ATT_EST, FSW_FDIR, THR_CMD_0..3 (on-times of 4 thrusters each, the cycle
-number and the newest IMU_RATE counter used).
+Frames in: the bench's SYNC, IMU_RATE, IMU_ACCEL, STR_QUAT, NAV_POS, NAV_VEL, THR_STATUS,
+BENCH_STATUS, checked on receipt by :class:`dbc.codec.FrameChecker` (ID, extended flag,
+DLC, CRC, alive counter, range; our own messages heard from another node are counted
+``unexpected``). Frames out (flight_sw.frames): FSW_STATUS (also the boot heartbeat),
+FSW_ATT_EST, FSW_FDIR, THR_CMD_0..m. IDs, periods and counter widths come from the DBC
+(dbc.icd).
 
-Bench restart: a SYNC whose cycle goes back to 0 (or more than ``STALE_SYNC_WINDOW`` cycles
-back), or a BENCH_STATUS whose SimTime goes backwards, means the bench started a new run:
-the flight computer is re-initialised on the bench's new time
+Freshness, taken before a frame counts (a rejected frame moves no alive counter): a SYNC
+whose cycle is not newer than the last one taken is ``stale``, as is a BENCH_STATUS whose
+time goes backwards, unless the bench restarted. Bench restart: a SYNC whose cycle goes
+back to 0 (or more than ``STALE_SYNC_WINDOW`` cycles back), or a BENCH_STATUS whose time
+goes backwards, after the bench has been quiet (no frame of it taken) for at least
+``RESTART_QUIET_NS`` of wall-clock time: a restarted bench is silent far longer (it waits
+for our heartbeat). Then the flight computer is re-initialised on the bench's new time
 (:meth:`FlightComputer.restart`), the cycle bookkeeping starts again and the new SYNC is
-answered (never a hang). A SYNC one or two cycles back is a stale frame, rejected.
+answered. Without the quiet period such a frame is a replay or a forgery: rejected as
+stale and counted in ``restarts_refused``, never a restart.
 In realtime the flight computer's manoeuvre time is aligned on the first BENCH_STATUS.
 Heartbeat: FSW_STATUS alone at start-up and after every second without any received frame
-(before the first SYNC, or when the bench has gone), so a restarted bench finds us.
+(before the first SYNC), and after ``LOCKSTEP_SILENCE_HEARTBEAT_S`` once cycling.
 
 Modes: ``lockstep`` — one control cycle per SYNC(k), at the simulation time it carries;
 ``realtime`` — cycles on this process's own monotonic timer (period from the DBC), with
@@ -24,10 +30,7 @@ FSW_STATUS period. Runs until SIGTERM/SIGINT, then writes its statistics file an
 
 from __future__ import annotations
 
-import json
-import math
 import signal
-from dataclasses import dataclass, field
 from pathlib import Path
 from types import FrameType
 from typing import Any
@@ -37,14 +40,21 @@ import numpy as np
 from cantools.database.can import Database
 
 from dbc.bus import recv_spinning, send_frames
-from dbc.codec import Decoded, Encoder, FrameChecker, Reject, cycle_time_ns
+from dbc.codec import Decoded, Encoder, FrameChecker, Reject
+from dbc.icd import BENCH, FSW, Icd
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 from flight_sw.clock import MonotonicClock
 from flight_sw.computer import CycleResult, FlightComputer
-from flight_sw.fdir.base import NO_THRUSTER
+from flight_sw.frames import command_signals, fdir_signals, status_signals
 from flight_sw.rx_log import ReceiveLog
+from flight_sw.stats import (
+    NodeStats,
+    percentiles_us,
+    second_sender_evidence,
+    spread,
+    write_json_atomic,
+)
 
-THRUSTERS_PER_CMD_FRAME = 4
 HEARTBEAT_RETRY_S = 1.0  # silence before the next FSW_STATUS heartbeat, until the first SYNC
 # Lockstep, once cycling: the bench is the time master and may be silent for a while without
 # being gone (paused in a debugger; its send held up to hilbus.MEMBER_STALL_S = 1 s by a
@@ -52,36 +62,13 @@ HEARTBEAT_RETRY_S = 1.0  # silence before the next FSW_STATUS heartbeat, until t
 # deterministic trace and shift FSW_STATUS's alive counter. A restarted bench waits for the
 # heartbeat up to its startup timeout (60 s by default), so a longer silence is harmless.
 LOCKSTEP_SILENCE_HEARTBEAT_S = 5.0
-CYCLE_MODULUS = 256
-STATUS_CYCLE_MODULUS = 65536
-OVERRUN_MAX = 255
-ON_TIME_LSB_S = 1e-4
-MAX_CMD_FRAMES = 4  # THR_CMD_0..3 in the DBC
-CMD_FRAMES = tuple(f"THR_CMD_{f}" for f in range(MAX_CMD_FRAMES))
-ON_TIME_SIGNALS = tuple(f"OnTime_T{k:02d}" for k in range(MAX_CMD_FRAMES * THRUSTERS_PER_CMD_FRAME))
-# A full-period pulse is sent this much longer, to bridge command-arrival jitter (see
-# ``send_commands``); far below the DBC's 102.3 ms and the bench's valve watchdog.
-FULL_ON_OVERLAP_S = 0.005
-MS_PER_S = 1000
-NS_PER_MS = 1_000_000
-BENCH_FRAMES = frozenset(
-    {
-        "SYNC",
-        "IMU_RATE",
-        "IMU_ACCEL",
-        "STR_QUAT",
-        "NAV_POS",
-        "NAV_VEL",
-        "THR_STATUS",
-        "BENCH_STATUS",
-    }
-)
 # A SYNC at most this many cycles behind the last one is stale; further back, a restart.
 STALE_SYNC_WINDOW = 2
-DETECTION_TIME_MAX_S = 655.35  # FSW_FDIR.DetectionTime range
-ISOLATION_DELAY_MAX_S = 2.55  # FSW_FDIR.IsolationDelay range
-ALLOC_RESIDUAL_MAX_NM = 12.75  # FSW_STATUS.AllocResidual range
-ALLOC_RESIDUAL_MAX_N = 12.75  # FSW_STATUS.AllocForceResidual range
+RESTART_QUIET_NS = 200_000_000  # bench silence [ns, wall clock] before a restart is taken
+MS_PER_S = 1000
+NS_PER_MS = 1_000_000
+NS_PER_S = 1e9
+STATS_EVERY_STATUS_PERIODS = 10  # realtime: the statistics file is rewritten this often
 
 
 def _next_phase_ns(now_ns: int, base_ns: int, period_ns: int, phase_ns: int) -> int:
@@ -90,83 +77,47 @@ def _next_phase_ns(now_ns: int, base_ns: int, period_ns: int, phase_ns: int) -> 
     return base_ns + k * period_ns + phase_ns
 
 
-def _spread(values: list[float]) -> dict[str, float | None]:
-    """p50, p99 and max of ``values`` (full precision; the bus carries 0.05 steps)."""
-    if not values:
-        return {"p50": None, "p99": None, "max": None}
-    p50, p99 = np.percentile(np.asarray(values, dtype=float), (50.0, 99.0))
-    return {"p50": float(p50), "p99": float(p99), "max": float(max(values))}
-
-
-def _percentiles_us(samples_ns: list[int]) -> dict[str, float | int | None]:
-    """p50, p99 and max of ``samples_ns`` in microseconds."""
-    if not samples_ns:
-        return {"p50": None, "p99": None, "max": None, "n": 0}
-    a = np.asarray(samples_ns, dtype=float) / 1e3
-    p50, p99 = np.percentile(a, (50.0, 99.0))
-    return {
-        "p50": round(float(p50), 1),
-        "p99": round(float(p99), 1),
-        "max": round(float(a.max()), 1),
-        "n": len(samples_ns),
-    }
+def _ms_to_ns(t_s: float) -> int:
+    """A SimTime signal [s] (1 ms LSB) on the flight software's ns time axis."""
+    return round(float(t_s) * MS_PER_S) * NS_PER_MS
 
 
 class StopRequested(Exception):  # noqa: N818 - a request, not an error
     """Raised by the signal handler to leave a blocking receive at once."""
 
 
-@dataclass
-class NodeStats:
-    """Counters the node reports at exit."""
-
-    cycles: int = 0
-    overruns: int = 0
-    restarts: int = 0
-    sent: dict[str, int] = field(default_factory=dict)
-    cycle_ns: list[int] = field(default_factory=list)  # cycle start -> last frame sent
-    residual_Nm: list[float] = field(default_factory=list)  # allocation torque residual
-    residual_N: list[float] = field(default_factory=list)  # allocation force residual
-    saturated_cycles: int = 0
-
-
 class FlightNode:
     """Binds a FlightComputer to a bus."""
 
-    def __init__(
-        self,
-        db: Database,
-        bus: can.BusABC,
-        computer: FlightComputer,
-        stats_path: Path | None = None,
-        rx_log: ReceiveLog | None = None,
-    ) -> None:
+    def __init__(self, db: Database, bus: can.BusABC, computer: FlightComputer,
+                 stats_path: Path | None = None, rx_log: ReceiveLog | None = None,
+                 clock: MonotonicClock | None = None) -> None:
         self.db = db
+        self.icd = icd = Icd.from_database(db)
         self.rx_log = rx_log  # realtime: when each frame arrived (flight_sw/rx_log.py)
         self.bus = bus
         self.fc = computer
         self.encoder = Encoder(db)
-        self.checker = FrameChecker(db, accept=BENCH_FRAMES)
+        self.checker = FrameChecker(db, accept=icd.sent_by(BENCH), own=icd.sent_by(FSW))
         self.stats = NodeStats()
-        self.clock = MonotonicClock()
+        self.clock = clock or MonotonicClock()
         self.stats_path = stats_path
         self.n_thr = len(computer.modulators)
-        self.n_cmd_frames = math.ceil(self.n_thr / THRUSTERS_PER_CMD_FRAME)
-        self.period_ns = cycle_time_ns(db, "THR_CMD_0")
-        self.status_every = max(1, cycle_time_ns(db, "FSW_STATUS") // self.period_ns)
+        self.period_ns = icd.control_period_ns
+        self.status_every = max(1, icd.period_ns["FSW_STATUS"] // self.period_ns)
+        self._sync_modulus = icd.sync_cycle_modulus
         self._stop = False
         self._waiting = False  # blocked in the bus receive: a stop signal may interrupt
         self.lockstep_silence_heartbeat_s = LOCKSTEP_SILENCE_HEARTBEAT_S
         self.lockstep_spin_s = 0.0  # lockstep: poll this long before blocking (dbc.bus)
+        self.restart_quiet_ns = RESTART_QUIET_NS
         self._last_sync: int | None = None
         self._pending_seen: set[str] = set()
         self._sync_cycle = -1
-        self._last_flags = 0
-        self._last_sat = False
-        self._last_residual = 0.0
         self._last_result: CycleResult | None = None
         self._reported: tuple[int, int, int] | None = None  # (mode, FDIR, sensor flags) sent
         self._bench_time_ns: int | None = None  # newest BENCH_STATUS SimTime
+        self._bench_heard_ns: int | None = None  # our clock when a bench frame was last taken
         self._realtime = False
         self._time_aligned = False
         # lockstep: the frames of the cycle being computed, sent together at its end
@@ -224,80 +175,23 @@ class FlightNode:
         self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
 
     def _send_held(self) -> None:
-        """The cycle's frames, in the order encoded, as one burst (see dbc.bus.send_frames)."""
+        """The cycle's frames, in the order encoded, as one burst (dbc.bus.send_frames)."""
         held = self._held or []
         send_frames(self.bus, [msg for _name, msg in held])
         for name, _msg in held:
             self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
 
-    def _status_signals(self, cycle: int) -> dict[str, float]:
-        """FSW_STATUS content: mode, counters, FDIR flags, the allocation's saturation/residual."""
-        res = self._last_result
-        return {
-            "Mode": int(self.fc.mode),
-            "Cycle": cycle % STATUS_CYCLE_MODULUS,
-            "Overruns": min(self.stats.overruns, OVERRUN_MAX),
-            "FdirFlags": self._last_flags,
-            "AllocSaturated": int(self._last_sat),
-            "AllocResidual": min(self._last_residual, ALLOC_RESIDUAL_MAX_NM),
-            "AllocForceResidual": min(
-                res.residual_force_N if res is not None else 0.0, ALLOC_RESIDUAL_MAX_N
-            ),
-        }
+    def _status(self, cycle: int) -> dict[str, float | int]:
+        return status_signals(self.icd, int(self.fc.mode), cycle, self.stats.overruns,
+                              self._last_result)
 
     def send_status(self, cycle: int) -> None:
         """FSW_STATUS, FSW_ATT_EST and FSW_FDIR."""
-        fc = self.fc
-        self._send("FSW_STATUS", self._status_signals(cycle))
-        est = fc.estimator.estimate()
+        self._send("FSW_STATUS", self._status(cycle))
+        est = self.fc.estimator.estimate()
         q = [float(x) for x in est.q_BN]
         self._send("FSW_ATT_EST", {"Valid": int(est.initialised), **pack_quaternion(q)})
-        self._send("FSW_FDIR", self._fdir_signals())
-
-    def _fdir_signals(self) -> dict[str, float | int]:
-        """FSW_FDIR from the last cycle (all thrusters available before the first cycle)."""
-        res = self._last_result
-        rep = res.fdir if res is not None else None
-        if rep is None:
-            return {
-                "AvailableMask": (1 << self.n_thr) - 1,
-                "FailedThruster": NO_THRUSTER,
-                "FailureKind": 0,
-                "DetectionTime": 0.0,
-                "IsolationDelay": 0.0,
-                "SensorFlags": res.sensor_flags if res is not None else 0,
-            }
-        return {
-            "AvailableMask": rep.available_mask,
-            "FailedThruster": rep.failed_thruster,
-            "FailureKind": int(rep.failure_kind),
-            "DetectionTime": min(max(rep.detection_time_s, 0.0), DETECTION_TIME_MAX_S),
-            "IsolationDelay": min(max(rep.isolation_delay_s, 0.0), ISOLATION_DELAY_MAX_S),
-            "SensorFlags": res.sensor_flags if res is not None else 0,
-        }
-
-    def send_commands(self, cycle: int, res: CycleResult) -> None:
-        """THR_CMD_0..m for one cycle (thrusters beyond the vehicle's count are 0).
-
-        A full-period on-time is sent ``FULL_ON_OVERLAP_S`` longer, so that consecutive
-        full-on pulses overlap the next command, which continues the energised coil: no
-        closing and re-opening transient when a command arrives a little later than the
-        previous one (e.g. behind the status frames). The next command always ends or
-        continues it, so the thrust is that of a continuous pulse.
-        """
-        max_on = self.period_ns / 1e9
-        for f in range(self.n_cmd_frames):
-            sig: dict[str, float | int] = {
-                "Cycle": cycle % CYCLE_MODULUS,
-                "ImuCounter": res.imu_counter,
-            }
-            for j in range(THRUSTERS_PER_CMD_FRAME):
-                k = f * THRUSTERS_PER_CMD_FRAME + j
-                on = min(max(res.on_time_s[k] if k < self.n_thr else 0.0, 0.0), max_on)
-                if on >= max_on:
-                    on = max_on + FULL_ON_OVERLAP_S
-                sig[ON_TIME_SIGNALS[k]] = round(on / ON_TIME_LSB_S) * ON_TIME_LSB_S
-            self._send(CMD_FRAMES[f], sig)
+        self._send("FSW_FDIR", fdir_signals(self.icd, self.n_thr, self._last_result))
 
     def run_cycle(self, cycle: int, t_ns: int) -> None:
         """One control cycle at ``t_ns`` and its frames (status first, commands last).
@@ -320,22 +214,19 @@ class FlightNode:
     def _cycle_frames(self, cycle: int, t_ns: int) -> None:
         res = self.fc.cycle(t_ns)
         self._last_result = res
-        self._last_flags, self._last_sat, self._last_residual = (
-            res.fdir_flags,
-            res.saturated,
-            res.residual_Nm,
-        )
-        self.stats.cycles += 1
-        self.stats.residual_Nm.append(res.residual_Nm)
-        self.stats.residual_N.append(res.residual_force_N)
-        self.stats.saturated_cycles += bool(res.saturated)
+        st = self.stats
+        st.cycles += 1
+        st.residual_Nm.append(res.residual_Nm)
+        st.residual_N.append(res.residual_force_N)
+        st.saturated_cycles += bool(res.saturated)
         # Status at its DBC rate, and at once when the mode or a flag changes: the bench
         # and the operator learn of a safe-mode entry or an isolation in the same cycle.
         reported = (int(self.fc.mode), res.fdir_flags, res.sensor_flags)
         if cycle % self.status_every == 0 or reported != self._reported:
             self._reported = reported
             self.send_status(cycle)
-        self.send_commands(cycle, res)
+        for name, sig in command_signals(self.icd, cycle, res, self.n_thr, self.period_ns):
+            self._send(name, sig)
 
     # -- receive -----------------------------------------------------------------
     def handle(self, d: Decoded, t_ns: int) -> None:
@@ -365,19 +256,39 @@ class FlightNode:
                 fc.on_nav_vel(t_ns, np.array((s["VelX"], s["VelY"], s["VelZ"])))
         elif name == "THR_STATUS":
             fc.on_thr_status(t_ns, s)
-        elif name == "BENCH_STATUS":
-            self._on_bench_time(round(float(s["SimTime"]) * MS_PER_S) * NS_PER_MS, t_ns)
 
-    def _on_bench_time(self, bench_ns: int, t_ns: int) -> None:
-        """BENCH_STATUS SimTime: a step back is a bench restart; realtime aligns on it (the
-        first one, then any that shows the bench's time 0 earlier)."""
+    def _bench_quiet(self, now_ns: int) -> bool:
+        """The bench has been silent long enough for a restart to be genuine."""
+        heard = self._bench_heard_ns
+        return heard is None or now_ns - heard >= self.restart_quiet_ns
+
+    def _take(self, d: Decoded, now_ns: int) -> None:
+        """The frame passed every check and its freshness: it counts."""
+        self.checker.accept(d)
+        self._bench_heard_ns = now_ns
+
+    def _refuse_restart(self, d: Decoded) -> None:
+        """A frame that would restart us while the bench is live: stale, counted."""
+        self.checker.reject(d.name, Reject.STALE)
+        self.stats.restarts_refused += 1
+
+    def _on_bench_status(self, d: Decoded, now_ns: int) -> None:
+        """BENCH_STATUS SimTime: a step back is a bench restart (after a quiet bench) or
+        stale; realtime aligns the timeline on it (the first one, then any that shows the
+        bench's time 0 earlier)."""
+        bench_ns = _ms_to_ns(d.signals["SimTime"])
         last = self._bench_time_ns
-        self._bench_time_ns = bench_ns
         if last is not None and bench_ns < last:
-            now = self.clock.now_ns() if self._realtime else bench_ns
-            self.bench_restarted(now, bench_ns)
+            if not self._bench_quiet(now_ns):
+                self._refuse_restart(d)
+                return
+            self._take(d, now_ns)
+            self.bench_restarted(self.clock.now_ns() if self._realtime else bench_ns, bench_ns)
             self._bench_time_ns = bench_ns
-        elif self._realtime:
+            return
+        self._take(d, now_ns)
+        self._bench_time_ns = bench_ns
+        if self._realtime:
             # our time of the bench's time 0: the earliest estimate so far (each arrives
             # late by its transport and our own reading delay, never early; same clock)
             base = self.clock.now_ns() - bench_ns
@@ -398,18 +309,31 @@ class FlightNode:
         self._time_aligned = self._realtime
 
     def _heartbeat(self) -> None:
-        """FSW_STATUS alone: BOOT before the first cycle, else the current state.
-
-        Sent at start-up and after every second without any frame (before the first SYNC,
-        or when the bench has gone: a restarted bench waits for this frame to start); in
-        lockstep once cycling, after ``LOCKSTEP_SILENCE_HEARTBEAT_S`` without any frame.
-        """
-        self._send("FSW_STATUS", self._status_signals(self.stats.cycles))
+        """FSW_STATUS alone: BOOT before the first cycle, else the current state."""
+        self._send("FSW_STATUS", self._status(self.stats.cycles))
 
     # -- loops -------------------------------------------------------------------
+    def _sync(self, d: Decoded, now_ns: int) -> tuple[int, int] | None:
+        """A checked SYNC: (cycle, time) to run, or None when it is stale (counted)."""
+        cycle = int(d.signals["Cycle"])
+        t_ns = _ms_to_ns(d.signals["SimTime"])
+        if self._last_sync is not None and cycle <= self._sync_cycle:
+            if cycle != 0 and self._sync_cycle - cycle <= STALE_SYNC_WINDOW:
+                self.checker.reject("SYNC", Reject.STALE)
+                return None
+            if not self._bench_quiet(now_ns):
+                self._refuse_restart(d)
+                return None
+            self._take(d, now_ns)
+            self.bench_restarted(t_ns, t_ns)
+            return cycle, t_ns
+        self._take(d, now_ns)
+        return cycle, t_ns
+
     def run_lockstep(self) -> None:
         """Cycle on SYNC frames until stopped."""
         self._heartbeat()
+        clock = self.clock
         while not self._stop:
             silence_s = (HEARTBEAT_RETRY_S if self._last_sync is None
                          else self.lockstep_silence_heartbeat_s)
@@ -417,20 +341,21 @@ class FlightNode:
             if msg is None:
                 self._heartbeat()
                 continue
-            d = self.checker.check(msg)
+            now = clock.now_ns()
+            d = self.checker.inspect(msg, now)
             if d is None:
                 continue
+            if d.name == "BENCH_STATUS":
+                self._on_bench_status(d, now)
+                continue
             if d.name != "SYNC":
+                self._take(d, now)
                 self.handle(d, self._last_sync or 0)
                 continue
-            cycle = int(d.signals["Cycle"])
-            t_ns = round(float(d.signals["SimTime"]) * MS_PER_S) * NS_PER_MS
-            if self._last_sync is not None and cycle <= self._sync_cycle:
-                if cycle == 0 or self._sync_cycle - cycle > STALE_SYNC_WINDOW:
-                    self.bench_restarted(t_ns, t_ns)
-                else:
-                    self.checker.reject("SYNC", Reject.STALE)
-                    continue
+            run = self._sync(d, now)
+            if run is None:
+                continue
+            cycle, t_ns = run
             if self._last_sync is None:
                 self.fc.watchdog.start(t_ns)
             for name in self._pending_seen:
@@ -465,17 +390,9 @@ class FlightNode:
                 phased_base = base
                 next_ns = _next_phase_ns(now, base, period, self.fc.cycle_phase_ns)
             if now < next_ns:
-                msg = self._recv((next_ns - now) / 1e9)
+                msg = self._recv((next_ns - now) / NS_PER_S)
                 if msg is not None:
-                    if self.rx_log is not None:
-                        self.rx_log.row(msg)
-                    d = self.checker.check(msg)
-                    if d is not None:
-                        t = clock.now_ns()
-                        self.handle(d, t)
-                        for name in self._pending_seen:
-                            self.fc.watchdog.seen(name, t)
-                        self._pending_seen.clear()
+                    self._realtime_frame(msg)
                 continue
             self.run_cycle(cycle, next_ns)
             if self.rx_log is not None:
@@ -486,41 +403,44 @@ class FlightNode:
             while done >= next_ns:  # computation overran: skip the missed period(s)
                 self.stats.overruns += 1
                 next_ns += period
-            if cycle % (self.status_every * 10) == 0:
+            if cycle % (self.status_every * STATS_EVERY_STATUS_PERIODS) == 0:
                 self.write_stats()
         self.write_stats()
 
-    def _allocation_stats(self) -> dict[str, Any]:
-        """Residual of the allocation (demand − B T) over the run and saturated cycles."""
-        st = self.stats
-        return {
-            "residual_torque_Nm": _spread(st.residual_Nm),
-            "residual_force_N": _spread(st.residual_N),
-            "saturated_cycles": st.saturated_cycles,
-            "cycles": st.cycles,
-        }
+    def _realtime_frame(self, msg: can.Message) -> None:
+        """A frame read in realtime: logged, checked, fed to the computer at its arrival."""
+        if self.rx_log is not None:
+            self.rx_log.row(msg)
+        t = self.clock.now_ns()
+        d = self.checker.inspect(msg, t)
+        if d is None:
+            return
+        if d.name == "BENCH_STATUS":
+            self._on_bench_status(d, t)
+            return
+        self._take(d, t)
+        self.handle(d, t)
+        for name in self._pending_seen:
+            self.fc.watchdog.seen(name, t)
+        self._pending_seen.clear()
 
+    # -- statistics --------------------------------------------------------------
     def _fdir_stats(self) -> dict[str, Any]:
         """Isolated thruster failures (times relative to the bench's time 0) and flags."""
-        fc = self.fc
         res = self._last_result
         out: dict[str, Any] = {
             "sensor_flags": res.sensor_flags if res is not None else 0,
             "fdir_flags": res.fdir_flags if res is not None else 0,
             "failures": [],
         }
-        fdir = fc.thruster_fdir
+        fdir = self.fc.thruster_fdir
         if fdir is not None:
             base = fdir.time_base_ns
             out["available_mask"] = int(sum(1 << k for k in range(fdir.n) if fdir.mask[k]))
             out["failures"] = [
-                {
-                    "thruster": f.thruster,
-                    "kind": f.kind.name.lower(),
-                    "t_detect_s": (f.t_detect_ns - base) / 1e9,
-                    "t_isolate_s": (f.t_isolate_ns - base) / 1e9,
-                    "source": f.source,
-                }
+                {"thruster": f.thruster, "kind": f.kind.name.lower(),
+                 "t_detect_s": (f.t_detect_ns - base) / NS_PER_S,
+                 "t_isolate_s": (f.t_isolate_ns - base) / NS_PER_S, "source": f.source}
                 for f in fdir.failures
             ]
         return out
@@ -529,24 +449,27 @@ class FlightNode:
         """Write the node's statistics JSON (atomically) if a path was given."""
         if self.stats_path is None:
             return
+        st = self.stats
+        received = self.checker.summary()
         data: dict[str, Any] = {
-            "cycles": self.stats.cycles,
-            "overruns": self.stats.overruns,
-            "sent": dict(sorted(self.stats.sent.items())),
-            "received": self.checker.summary(),
+            "cycles": st.cycles,
+            "overruns": st.overruns,
+            "sent": dict(sorted(st.sent.items())),
+            "received": received,
+            "second_sender_evidence": second_sender_evidence(received),
             "mode": self.fc.mode.name,
-            "cycle_time_us": _percentiles_us(self.stats.cycle_ns),
-            "allocation": self._allocation_stats(),
+            "cycle_time_us": percentiles_us(st.cycle_ns),
+            "allocation": {"residual_torque_Nm": spread(st.residual_Nm),
+                           "residual_force_N": spread(st.residual_N),
+                           "saturated_cycles": st.saturated_cycles, "cycles": st.cycles},
             "inertia_estimate_B_kgm2": (
-                None if self.fc.inertia_B_kgm2 is None else self.fc.inertia_B_kgm2.tolist()
-            ),
-            "restarts": self.stats.restarts,
+                None if self.fc.inertia_B_kgm2 is None else self.fc.inertia_B_kgm2.tolist()),
+            "restarts": st.restarts,
+            "restarts_refused": st.restarts_refused,
             "fdir": self._fdir_stats(),
             # portable bus: frames not delivered to a member that stopped reading
             "bus_overrun_drops": getattr(self.bus, "overrun_drops", 0),
             "bus_overrun_drops_by_pid": {
                 str(k): v for k, v in getattr(self.bus, "overrun_drops_by_pid", {}).items()},
         }
-        tmp = self.stats_path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(data, indent=2), encoding="utf-8")
-        tmp.replace(self.stats_path)
+        write_json_atomic(self.stats_path, data)

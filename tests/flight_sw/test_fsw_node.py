@@ -24,7 +24,8 @@ from dbc.database import load_database
 from dbc.quaternion import pack_quaternion
 from flight_sw.config import build_computer
 from flight_sw.modes import FdirFlag, Mode, SensorFlag
-from flight_sw.node import FULL_ON_OVERLAP_S, HEARTBEAT_RETRY_S, FlightNode
+from flight_sw.frames import FULL_ON_OVERLAP_S
+from flight_sw.node import HEARTBEAT_RETRY_S, RESTART_QUIET_NS, FlightNode
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 RECV_TIMEOUT_S = 5.0
@@ -211,8 +212,10 @@ def test_fsw_fdir_is_sent_with_each_status(setup: tuple[FlightNode, Bench]) -> N
 
 
 def test_sync_back_to_zero_is_a_bench_restart(setup: tuple[FlightNode, Bench]) -> None:
-    """SYNC(0) after SYNC(6): answered, the computer starts again, SensorFlags bit 3 set."""
+    """SYNC(0) after SYNC(6) from a bench that was quiet (here: no quiet period asked):
+    answered, the computer starts again, SensorFlags bit 3 set."""
     node, bench = setup
+    node.restart_quiet_ns = 0
     for k in range(7):
         bench.sensors()
         bench.sync(k)
@@ -232,8 +235,10 @@ def test_sync_back_to_zero_is_a_bench_restart(setup: tuple[FlightNode, Bench]) -
 
 
 def test_bench_time_going_backwards_is_a_restart(setup: tuple[FlightNode, Bench]) -> None:
-    """BENCH_STATUS SimTime 0.1 s then 0.0 s: restart; the next SYNC(0) is answered."""
+    """BENCH_STATUS SimTime 0.1 s then 0.0 s from a quiet bench: restart; the next SYNC(0)
+    is answered."""
     node, bench = setup
+    node.restart_quiet_ns = 0
     for k in range(6):
         bench.sensors()
         if k == 5:
@@ -259,3 +264,36 @@ def test_heartbeat_resumes_when_the_bench_goes_quiet(setup: tuple[FlightNode, Be
     d = bench.chk.check(msg)
     assert d is not None and d.name == "FSW_STATUS"
     assert d.signals["Mode"] == Mode.NOMINAL
+
+
+def test_replayed_sync_zero_from_a_live_bench_is_stale_not_a_restart(
+        setup: tuple[FlightNode, Bench]) -> None:
+    """The first SYNC(0), replayed while the bench answers every cycle: rejected as stale
+    (a refused restart), never a restart; the next genuine SYNC is answered as usual."""
+    node, bench = setup
+    assert node.restart_quiet_ns == RESTART_QUIET_NS
+    for k in range(4):
+        bench.sensors()
+        bench.sync(k)
+    bench.send("SYNC", {"Cycle": 0, "SimTime": 0.0})  # a valid frame: a fresh alive counter
+    bench.sensors()
+    got = bench.sync(4)
+    assert got["THR_CMD_0"]["Cycle"] == 4
+    assert node.fc.restarts == 0 and node.stats.restarts == 0
+    assert node.stats.restarts_refused == 1
+    assert node.checker.summary()["SYNC"]["rejected"] == {"stale": 1}
+
+
+def test_own_messages_from_another_node_are_counted_unexpected(
+        setup: tuple[FlightNode, Bench]) -> None:
+    """A well-formed THR_CMD_0 sent by someone else is counted ``unexpected`` by the flight
+    software (a second sender of its messages), and changes nothing."""
+    node, bench = setup
+    bench.sensors()
+    bench.sync(0)
+    sig = dict.fromkeys(node.icd.payload["THR_CMD_0"], 0)
+    bench.bus.send(bench.enc.message("THR_CMD_0", sig))
+    bench.sensors()
+    got = bench.sync(1)
+    assert got["THR_CMD_0"]["Cycle"] == 1
+    assert node.checker.summary()["THR_CMD_0"]["rejected"] == {"unexpected": 1}
