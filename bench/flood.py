@@ -19,8 +19,8 @@ import can
 import numpy as np
 
 from dbc import load_database
-from dbc.bus import open_bus
 from dbc.codec import Encoder
+from transport.spec import open_bus
 
 CAUSES = ("unknown_id", "error_frame", "crc", "dlc", "remote_frame")
 TARGETS = {"FSW": "IMU_ACCEL", "BENCH": "FSW_ATT_EST"}  # a message each side consumes

@@ -17,9 +17,9 @@ import can
 
 from bench.faults import FAULT_CMD_KINDS
 from dbc import e2e, load_database
-from dbc.bus import open_bus
 from dbc.codec import Encoder, FrameChecker
 from dbc.errors import ConfigError, RefusedConfigError, RunError
+from transport.spec import open_bus
 
 COUNTER_NONE = 15
 INJECT_SOURCE = "thruster-hil inject"

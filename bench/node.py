@@ -54,10 +54,10 @@ from bench.plant import STEP_NS, Plant
 from bench.recorder import CHAIN_COLUMNS, NAN, TelemetryWriter, TraceRecorder, write_summary
 from bench.reference import KIND_STEP, attitude_error_deg, rate_error_B, reference
 from bench.scenario import Scenario
-from dbc.bus import recv_spinning, send_frames
 from dbc.codec import Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.errors import RunError
 from dbc.quaternion import pack_quaternion, unpack_quaternion
+from transport.lockstep import recv_spinning, send_frames
 
 WATCHDOG_PERIODS = 3
 MODE_BOOT = 0  # FSW_STATUS.Mode
@@ -273,7 +273,8 @@ class BenchNode:
         # software's commands within it (the rest is the bench's own work)
         self.cycle_wall_ns: list[int] = []
         self.fsw_wait_ns: list[int] = []
-        self.lockstep_spin_s = 0.0  # poll this long before blocking for commands (dbc.bus)
+        # poll this long before blocking for commands (transport.lockstep)
+        self.lockstep_spin_s = 0.0
         self.fsw_alive: Callable[[], bool] | None = None
         self._wire_pending: dict[int, tuple[can.Message, bool, int]] = {}
         self.last_sync_ns = 0  # lockstep: time of the run's last SYNC
@@ -623,7 +624,8 @@ class BenchNode:
         self.queue.clear()
 
     def _release_tx(self) -> None:
-        """Hand the held frames to the bus, in order, together (see dbc.bus.send_frames)."""
+        """Hand the held frames to the bus, in order, together (see
+        transport.lockstep.send_frames)."""
         if self._tx_held:
             send_frames(self.bus, self._tx_held)
             self._tx_held = []

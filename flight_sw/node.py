@@ -36,13 +36,13 @@ import can
 import numpy as np
 from cantools.database.can import Database
 
-from dbc.bus import recv_spinning, send_frames
 from dbc.codec import Decoded, Encoder, FrameChecker, Reject, cycle_time_ns
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 from flight_sw.clock import MonotonicClock
 from flight_sw.computer import CycleResult, FlightComputer
 from flight_sw.fdir.base import NO_THRUSTER
 from flight_sw.rx_log import ReceiveLog
+from transport.lockstep import recv_spinning, send_frames
 
 THRUSTERS_PER_CMD_FRAME = 4
 HEARTBEAT_RETRY_S = 1.0  # silence before the next FSW_STATUS heartbeat, until the first SYNC
@@ -157,7 +157,7 @@ class FlightNode:
         self._stop = False
         self._waiting = False  # blocked in the bus receive: a stop signal may interrupt
         self.lockstep_silence_heartbeat_s = LOCKSTEP_SILENCE_HEARTBEAT_S
-        self.lockstep_spin_s = 0.0  # lockstep: poll this long before blocking (dbc.bus)
+        self.lockstep_spin_s = 0.0  # lockstep: poll this long before blocking (transport.lockstep)
         self._last_sync: int | None = None
         self._pending_seen: set[str] = set()
         self._sync_cycle = -1
@@ -224,7 +224,8 @@ class FlightNode:
         self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
 
     def _send_held(self) -> None:
-        """The cycle's frames, in the order encoded, as one burst (see dbc.bus.send_frames)."""
+        """The cycle's frames, in the order encoded, as one burst (see
+        transport.lockstep.send_frames)."""
         held = self._held or []
         send_frames(self.bus, [msg for _name, msg in held])
         for name, _msg in held:

@@ -25,8 +25,8 @@ from bench.node import NS_PER_S, RT_FRAMES_PER_PASS, BenchNode, Clock
 from bench.plant import STEP_NS
 from bench.scenario import load_scenario
 from dbc import load_database
-from dbc.bus import open_bus
 from dbc.codec import Encoder, cycle_time_ns
+from transport.spec import open_bus
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 OVERLOAD_SPEEDUP = 20  # the bench's clock against the wall clock: beyond what it keeps up with

@@ -10,8 +10,8 @@ import can
 from bench.node import BenchNode
 from bench.scenario import load_scenario
 from dbc import load_database
-from dbc.bus import open_bus
 from dbc.codec import Encoder
+from transport.spec import open_bus
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 UNKNOWN_ID = 0x7FE  # not in the DBC

@@ -1,18 +1,16 @@
 """Back-to-back contract tests: every bus the project uses behaves the same way.
 
-Two buses A and B opened on the same channel through :func:`dbc.bus.open_bus` (like
+Two buses A and B opened on the same channel through :func:`transport.spec.open_bus` (like
 python-can's back2back tests): frames sent by A arrive at B unchanged and in order, B's
-frames arrive at A, ``send_frames`` (one burst where the bus takes bursts) delivers like
-single sends, and ``recv`` and ``recv_spinning`` honour their timeouts. Run for ``virtual``
-and ``hilbus`` always, and for ``socketcan:vcan0`` where the kernel has it. Plus
-:class:`dbc.bus.BusSpec` parsing and :func:`dbc.bus.default_bus_spec`.
+frames arrive at A, :func:`transport.lockstep.send_frames` (one burst where the bus takes
+bursts) delivers like single sends, and ``recv`` and
+:func:`transport.lockstep.recv_spinning` honour their timeouts. Run for ``virtual`` and
+``hilbus`` always, and for ``socketcan:vcan0`` where the kernel has it.
 """
 
 from __future__ import annotations
 
-import os
 import shutil
-import socket
 import tempfile
 import threading
 import time
@@ -24,22 +22,8 @@ from pathlib import Path
 import can
 import pytest
 
-from dbc.bus import (
-    LOCKSTEP_SPIN_ENV,
-    LOCKSTEP_SPIN_MIN_CPUS,
-    LOCKSTEP_SPIN_S,
-    REALTIME_MEMBER_STALL_S,
-    SOCKETCAN_RCVBUF_BYTES,
-    BusSpec,
-    default_bus_spec,
-    enlarge_receive_buffer,
-    lockstep_spin_s,
-    mode_options,
-    open_bus,
-    recv_spinning,
-    send_frames,
-)
-from dbc.errors import BusError, ConfigError
+from transport.lockstep import LOCKSTEP_SPIN_S, recv_spinning, send_frames
+from transport.spec import open_bus
 
 DEADLINE_S = 30.0
 TIMEOUT_SLACK_S = 0.5
@@ -82,7 +66,7 @@ def pair(
     """Buses A and B on one fresh channel of the bus kind under test."""
     kind: Kind = request.param
     if kind.interface == "socketcan" and not VCAN.exists():
-        pytest.skip("no SocketCAN interface vcan0 on this kernel (see tests/dbc smoke tests)")
+        pytest.skip("no SocketCAN interface vcan0 on this kernel")
     runtime = Path(tempfile.mkdtemp(prefix="thb-"))
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
     spec = kind.spec()
@@ -237,142 +221,3 @@ def test_recv_spinning_timeout_semantics(pair: tuple[can.BusABC, can.BusABC, Kin
             t0 = time.monotonic()
             assert recv_spinning(b, 0.2, spin_s) is None
             assert 0.2 <= time.monotonic() - t0 < 0.2 + TIMEOUT_SLACK_S, spin_s
-
-
-def test_lockstep_spin_default_and_environment() -> None:
-    """Polling by default on enough CPUs, none on fewer; the environment variable wins."""
-    assert lockstep_spin_s(LOCKSTEP_SPIN_MIN_CPUS, {}) == LOCKSTEP_SPIN_S
-    assert lockstep_spin_s(LOCKSTEP_SPIN_MIN_CPUS - 1, {}) == 0.0
-    assert lockstep_spin_s(1, {LOCKSTEP_SPIN_ENV: "0.002"}) == 0.002
-    assert lockstep_spin_s(64, {LOCKSTEP_SPIN_ENV: "0"}) == 0.0
-
-
-@pytest.mark.parametrize("bad", ["fast", "-1", "nan", "inf", ""])
-def test_lockstep_spin_bad_environment_value_names_it(bad: str) -> None:
-    """A bad THRUSTER_HIL_LOCKSTEP_SPIN_S raises ConfigError naming the variable and value."""
-    with pytest.raises(ConfigError, match=rf"{LOCKSTEP_SPIN_ENV} = '{bad}'"):
-        lockstep_spin_s(2, {LOCKSTEP_SPIN_ENV: bad})
-
-
-# ---------------------------------------------------------------- bus specs
-
-
-@pytest.mark.parametrize(
-    ("spec", "interface", "channel", "options"),
-    [
-        ("socketcan:vcan0", "socketcan", "vcan0", ()),
-        ("hilbus:default", "hilbus", "default", ()),
-        ("pcan:PCAN_USBBUS1?bitrate=1000000", "pcan", "PCAN_USBBUS1", (("bitrate", "1000000"),)),
-        ("virtual:a:b", "virtual", "a:b", ()),
-    ],
-)
-def test_bus_spec_parse(
-    spec: str, interface: str, channel: str, options: tuple[object, ...]
-) -> None:
-    """Valid specs parse into interface, channel and options, and print back."""
-    bs = BusSpec.parse(spec)
-    assert (bs.interface, bs.channel, bs.options) == (interface, channel, options)
-    assert str(bs) == spec
-    assert bs.is_portable == (interface == "hilbus")
-
-
-@pytest.mark.parametrize("spec", ["vcan0", "", ":vcan0", "socketcan:", ":", "?bitrate=1"])
-def test_bus_spec_parse_errors(spec: str) -> None:
-    """A spec without INTERFACE:CHANNEL raises BusError naming the spec."""
-    with pytest.raises(BusError, match="expected INTERFACE:CHANNEL") as info:
-        BusSpec.parse(spec)
-    assert repr(spec) in str(info.value)
-
-
-def test_bus_spec_malformed_options_raise_bus_error() -> None:
-    """A malformed ?query raises BusError naming the spec."""
-    with pytest.raises(BusError, match="bitrate"):
-        BusSpec.parse("socketcan:vcan0?bitrate")
-
-
-def test_default_bus_spec(tmp_path: Path) -> None:
-    """socketcan:vcan0 where sys_net has vcan0, else the portable hilbus:default."""
-    assert default_bus_spec(tmp_path) == "hilbus:default"
-    (tmp_path / "vcan0").mkdir()
-    assert default_bus_spec(tmp_path) == "socketcan:vcan0"
-
-
-def test_open_bus_errors_name_the_spec(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Unknown interfaces and bad hilbus channels raise BusError naming the problem."""
-    with pytest.raises(BusError, match="nosuchinterface:x"):
-        open_bus("nosuchinterface:x")
-    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
-    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
-    try:
-        with pytest.raises(BusError, match="'bad name'"):
-            open_bus("hilbus:bad name")
-    finally:
-        shutil.rmtree(runtime, ignore_errors=True)
-
-
-def test_open_bus_passes_options(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Spec options and keyword arguments reach the bus (receive_own_messages here)."""
-    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
-    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
-    try:
-        with open_bus(f"hilbus:ct-{uuid.uuid4().hex[:8]}?receive_own_messages=true") as bus:
-            bus.send(can.Message(arbitration_id=0x33))
-            m = bus.recv(timeout=DEADLINE_S)
-            assert m is not None and m.arbitration_id == 0x33 and not m.is_rx
-    finally:
-        shutil.rmtree(runtime, ignore_errors=True)
-
-
-def test_realtime_on_the_portable_bus_does_not_wait_for_a_stopped_member() -> None:
-    """Realtime hilbus: member_stall_s is the short realtime one (a spec option wins);
-    lockstep and other interfaces get no extra option."""
-    assert mode_options("hilbus:x", "realtime") == {"member_stall_s": REALTIME_MEMBER_STALL_S}
-    assert mode_options("hilbus:x?member_stall_s=2", "realtime") == {}
-    assert mode_options("hilbus:x", "lockstep") == {}
-    assert mode_options("socketcan:vcan0", "realtime") == {}
-
-
-def test_a_realtime_send_to_a_stopped_member_is_held_only_the_realtime_stall(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    """A member that never reads: once its queue is full, a realtime sender waits at most
-    about REALTIME_MEMBER_STALL_S once (not hilbus's 1 s), then drops to it and counts."""
-    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
-    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
-    spec = f"hilbus:rt-{uuid.uuid4().hex[:8]}"
-    try:
-        with open_bus(spec, **mode_options(spec, "realtime")) as tx, open_bus(spec):
-            t0 = time.monotonic()
-            for _ in range(STREAM_N):
-                tx.send(can.Message(arbitration_id=0x33, data=b"\x00" * 8))
-            held_s = time.monotonic() - t0
-            assert tx.overrun_drops > 0  # type: ignore[attr-defined]
-            assert held_s < 1.0  # hilbus's lockstep stall alone would be 1 s
-    finally:
-        shutil.rmtree(runtime, ignore_errors=True)
-
-
-def test_enlarge_receive_buffer_grows_the_socket_buffer() -> None:
-    """The receive buffer grows past the kernel default; as root it reaches the request."""
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
-        before = sock.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)
-        granted = enlarge_receive_buffer(sock, size_bytes=4 * before)
-        assert granted >= before
-        if os.geteuid() == 0:  # SO_RCVBUFFORCE: the kernel doubles what it is given
-            assert granted >= 4 * before
-
-
-@pytest.mark.socketcan
-def test_socketcan_bus_has_the_large_receive_buffer() -> None:
-    """open_bus gives a socketcan bus the receive buffer that absorbs a burst of frames."""
-    if not VCAN.exists():
-        pytest.skip("no SocketCAN interface vcan0 on this kernel")
-    with (
-        can.Bus(interface="socketcan", channel="vcan0") as plain,
-        open_bus("socketcan:vcan0") as bus,
-    ):
-        default = plain.socket.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)  # type: ignore[attr-defined]
-        granted = bus.socket.getsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF)  # type: ignore[attr-defined]
-        assert granted >= default
-        if os.geteuid() == 0:  # SO_RCVBUFFORCE: the request itself, not capped by rmem_max
-            assert granted >= SOCKETCAN_RCVBUF_BYTES > default

@@ -1,4 +1,4 @@
-"""Tests of the portable cross-process CAN bus :mod:`dbc.hilbus`.
+"""Tests of the portable cross-process CAN bus :mod:`transport.hilbus`.
 
 Every test runs in its own private runtime directory (``$XDG_RUNTIME_DIR`` pointed at a
 fresh short temporary directory), so nothing touches the user's real channels. Waits are
@@ -27,7 +27,7 @@ import can
 import pytest
 
 from dbc.errors import BusError
-from dbc.hilbus import (
+from transport.hilbus import (
     BURST_MAX_RECORDS,
     HEADER,
     HilBus,
@@ -545,7 +545,7 @@ def test_python_can_entry_point_and_detect_configs(channel: str) -> None:
 def test_stale_socket_of_killed_process_is_removed(runtime: Path, channel: str) -> None:
     """A member killed without shutdown is dropped and its socket file unlinked on send."""
     code = (
-        "import sys; from dbc.hilbus import HilBus; "
+        "import sys; from transport.hilbus import HilBus; "
         f"b = HilBus({channel!r}); print(b.path, flush=True); sys.stdin.read()"
     )
     with HilBus(channel) as a, HilBus(channel) as b:
@@ -582,7 +582,7 @@ def test_stale_socket_of_live_process_is_skipped_not_unlinked(channel: str) -> N
 
 ECHO_CODE = """
 import can
-from dbc.hilbus import HilBus
+from transport.hilbus import HilBus
 with HilBus({channel!r}) as bus:
     bus.send(can.Message(arbitration_id=0x700))  # ready
     while True:

@@ -16,7 +16,7 @@ latency varies), the same as python-can's in-process ``virtual`` bus with an ech
 48k-165k frames/s one way, none lost.
 
 It is registered as a python-can interface (entry point ``can.interface``:
-``hilbus = "dbc.hilbus:HilBus"``), so any python-can program or stock tool attaches::
+``hilbus = "transport.hilbus:HilBus"``), so any python-can program or stock tool attaches::
 
     bus = can.Bus(interface="hilbus", channel="default")
     python -m can.logger -i hilbus -c default
