@@ -10,8 +10,6 @@ bursts) delivers like single sends, and ``recv`` and
 
 from __future__ import annotations
 
-import shutil
-import tempfile
 import threading
 import time
 import uuid
@@ -22,10 +20,10 @@ from pathlib import Path
 import can
 import pytest
 
+from tests.transport.helpers import DEADLINE_S, frame_key
 from transport.lockstep import LOCKSTEP_SPIN_S, recv_spinning, send_frames
 from transport.spec import open_bus
 
-DEADLINE_S = 30.0
 TIMEOUT_SLACK_S = 0.5
 STREAM_N = 300  # more than hilbus queues per socket on Linux: exercises blocking sends
 VCAN = Path("/sys/class/net/vcan0")
@@ -61,20 +59,15 @@ KINDS = [
 
 @pytest.fixture(params=KINDS)
 def pair(
-    request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch
+    request: pytest.FixtureRequest, runtime: Path
 ) -> Iterator[tuple[can.BusABC, can.BusABC, Kind]]:
     """Buses A and B on one fresh channel of the bus kind under test."""
     kind: Kind = request.param
     if kind.interface == "socketcan" and not VCAN.exists():
         pytest.skip("no SocketCAN interface vcan0 on this kernel")
-    runtime = Path(tempfile.mkdtemp(prefix="thb-"))
-    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
     spec = kind.spec()
-    try:
-        with open_bus(spec) as a, open_bus(spec) as b:
-            yield a, b, kind
-    finally:
-        shutil.rmtree(runtime, ignore_errors=True)
+    with open_bus(spec) as a, open_bus(spec) as b:
+        yield a, b, kind
 
 
 def _frames(kind: Kind, base: int) -> list[can.Message]:
@@ -100,23 +93,9 @@ def _frames(kind: Kind, base: int) -> list[can.Message]:
     return out
 
 
-def _key(m: can.Message) -> tuple[object, ...]:
-    return (
-        m.arbitration_id,
-        m.is_extended_id,
-        m.is_remote_frame,
-        m.is_error_frame,
-        m.is_fd,
-        m.bitrate_switch,
-        m.error_state_indicator,
-        m.dlc,
-        bytes(m.data),
-    )
-
-
 def _transfer(tx: can.BusABC, rx: can.BusABC, sent: list[can.Message]) -> list[can.Message]:
     """Send ``sent`` on tx while a thread receives as many frames of them on rx."""
-    wanted = {_key(m) for m in sent}
+    wanted = {frame_key(m) for m in sent}
     got: list[can.Message] = []
     failure: list[str] = []
 
@@ -128,7 +107,7 @@ def _transfer(tx: can.BusABC, rx: can.BusABC, sent: list[can.Message]) -> list[c
                 failure.append(f"only {len(got)}/{len(sent)} frames within {DEADLINE_S} s")
                 return
             m = rx.recv(timeout=left)
-            if m is not None and _key(m) in wanted:  # vcan0 may carry other traffic
+            if m is not None and frame_key(m) in wanted:  # vcan0 may carry other traffic
                 got.append(m)
 
     receiver = threading.Thread(target=receive, daemon=True)
@@ -145,7 +124,7 @@ def test_a_to_b_unchanged_in_order(pair: tuple[can.BusABC, can.BusABC, Kind]) ->
     a, b, kind = pair
     sent = _frames(kind, 0x1A0000)
     got = _transfer(a, b, sent)
-    assert [_key(m) for m in got] == [_key(m) for m in sent]
+    assert [frame_key(m) for m in got] == [frame_key(m) for m in sent]
     if (
         kind.interface != "socketcan"
     ):  # python-can marks locally originated SocketCAN frames is_rx=False
@@ -157,7 +136,7 @@ def test_b_to_a_unchanged_in_order(pair: tuple[can.BusABC, can.BusABC, Kind]) ->
     a, b, kind = pair
     sent = _frames(kind, 0x1B0000)
     got = _transfer(b, a, sent)
-    assert [_key(m) for m in got] == [_key(m) for m in sent]
+    assert [frame_key(m) for m in got] == [frame_key(m) for m in sent]
 
 
 def test_sender_does_not_receive_its_own(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
@@ -165,9 +144,9 @@ def test_sender_does_not_receive_its_own(pair: tuple[can.BusABC, can.BusABC, Kin
     a, b, kind = pair
     sent = _frames(kind, 0x1C0000)[:5]
     _transfer(a, b, sent)
-    own = {_key(m) for m in sent}
+    own = {frame_key(m) for m in sent}
     while (m := a.recv(timeout=0)) is not None:
-        assert _key(m) not in own
+        assert frame_key(m) not in own
 
 
 def test_recv_timeout_semantics(pair: tuple[can.BusABC, can.BusABC, Kind]) -> None:
@@ -196,12 +175,12 @@ def test_send_frames_arrive_like_single_sends(pair: tuple[can.BusABC, can.BusABC
     got: list[can.Message] = []
     send_frames(a, sent)
     deadline = time.monotonic() + DEADLINE_S
-    wanted = {_key(m) for m in sent}
+    wanted = {frame_key(m) for m in sent}
     while len(got) < len(sent) and (left := deadline - time.monotonic()) > 0:
         m = b.recv(timeout=left)
-        if m is not None and _key(m) in wanted:  # vcan0 may carry other traffic
+        if m is not None and frame_key(m) in wanted:  # vcan0 may carry other traffic
             got.append(m)
-    assert [_key(m) for m in got] == [_key(m) for m in sent]
+    assert [frame_key(m) for m in got] == [frame_key(m) for m in sent]
     send_frames(a, [])  # nothing to send: nothing sent, no error
 
 
