@@ -8,11 +8,11 @@ directory (:func:`runtime_dir`).
 Permissions: only the owning user can see or join a bus. Both directories are created
 with mode 0o700 and, when they already exist, must be real directories (not symlinks)
 owned by the current uid with no group/other permission bits, else
-:class:`~dbc.errors.BusError` names the path (someone else pre-creating
+:class:`~dbc.errors.BusInitError` names the path (someone else pre-creating
 ``/tmp/thruster-hil-<uid>`` cannot hijack it, only block it). Socket files are mode 0o600.
 Channel names are restricted to ``[A-Za-z0-9_.-]+`` (and not ``.``/``..``) so they cannot
-escape the directory. The socket path must fit ``sun_path`` (107 bytes on Linux, 103
-elsewhere).
+escape the directory (else :class:`~dbc.errors.BusArgumentError`). The socket path must
+fit ``sun_path`` (107 bytes on Linux, 103 elsewhere; else BusArgumentError).
 
 In: channel names, member socket names. Out: paths, a bound member socket
 (:func:`bind_member`), the pid in a member's name and whether it is alive, the channels
@@ -30,7 +30,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from dbc.errors import BusError
+from dbc.errors import BusArgumentError, BusInitError
 
 DEFAULT_CHANNEL = "default"
 CHANNEL_RE = re.compile(r"[A-Za-z0-9_.-]+")
@@ -77,10 +77,11 @@ def is_channel_name(name: str) -> bool:
 
 
 def check_channel(channel: object) -> str:
-    """Return ``channel`` as a valid channel name; raises BusError naming a bad value."""
+    """Return ``channel`` as a valid channel name; raises BusArgumentError naming a bad
+    value."""
     name = str(channel) if isinstance(channel, int) and not isinstance(channel, bool) else channel
     if not isinstance(name, str) or not is_channel_name(name):
-        raise BusError(
+        raise BusArgumentError(
             f"hilbus channel {channel!r}: expected a name of letters, digits, '_', '.', '-' "
             "(not '.' or '..')"
         )
@@ -94,12 +95,12 @@ def channel_dir(channel: str) -> Path:
 
 def new_member_path(directory: Path) -> Path:
     """A fresh member socket path in ``directory``: ``<pid>-<random hex>.sock``; raises
-    BusError if it is longer than the OS allows for a socket path."""
+    BusArgumentError if it is longer than the OS allows for a socket path."""
     token = os.urandom(MEMBER_TOKEN_BYTES).hex()
     path = directory / f"{os.getpid()}-{token}{SOCKET_SUFFIX}"
     limit_b = sun_path_max_b()
     if len(os.fsencode(path)) > limit_b:
-        raise BusError(
+        raise BusArgumentError(
             f"hilbus channel {directory.name!r}: socket path {path} is longer than the OS "
             f"allows ({limit_b} bytes); use a shorter channel name or a shorter "
             "$XDG_RUNTIME_DIR"
@@ -119,15 +120,15 @@ def secure_dir(path: Path) -> None:
     except FileExistsError:
         pass
     except OSError as exc:
-        raise BusError(f"hilbus: cannot create directory {path}: {exc.strerror}") from exc
+        raise BusInitError(f"hilbus: cannot create directory {path}: {exc.strerror}") from exc
     else:
         os.chmod(path, DIR_MODE)  # the umask may have taken bits away
     try:
         st = os.lstat(path)
     except OSError as exc:
-        raise BusError(f"hilbus: cannot inspect directory {path}: {exc.strerror}") from exc
+        raise BusInitError(f"hilbus: cannot inspect directory {path}: {exc.strerror}") from exc
     if not is_private_dir(st):
-        raise BusError(
+        raise BusInitError(
             f"hilbus: refusing directory {path}: it must be a directory (not a symlink) "
             f"owned by uid {os.getuid()} with mode 0700 (found uid {st.st_uid}, "
             f"mode {st.st_mode & PERMISSION_BITS:o}, type {'dir' if _isdir(st) else 'other'})"
@@ -145,7 +146,7 @@ def is_private_dir(st: os.stat_result) -> bool:
 
 def bind_member(sock: socket.socket, path: Path) -> None:
     """Create the channel's directories if needed and bind ``sock`` at ``path`` (mode
-    0o600); raises BusError naming the path if either fails."""
+    0o600); raises BusInitError naming the path if either fails."""
     secure_dir(path.parent.parent)
     secure_dir(path.parent)
     try:
@@ -154,7 +155,7 @@ def bind_member(sock: socket.socket, path: Path) -> None:
     except OSError as exc:
         with contextlib.suppress(OSError):
             os.unlink(path)
-        raise BusError(f"hilbus: cannot bind {path}: {exc}") from exc
+        raise BusInitError(f"hilbus: cannot bind {path}: {exc}") from exc
 
 
 def member_pid(name: str) -> int | None:

@@ -80,7 +80,7 @@ Limits
   some members and not others.
 * A member that joins while a frame is being sent may miss that frame.
 * ``shutdown()`` wakes threads blocked in ``recv()`` or ``send()`` on the same object
-  (they raise :class:`can.CanOperationError`).
+  (they raise :class:`~dbc.errors.BusOperationError`).
 * Path length: the socket path must fit ``sun_path`` (107 bytes on Linux, 103 elsewhere);
   a long ``$XDG_RUNTIME_DIR``/``$TMPDIR`` plus a long channel name is refused.
 * macOS queues datagrams by bytes (``SO_RCVBUF``) and answers a full receiver with
@@ -103,7 +103,12 @@ import can
 from can import BusState, CanProtocol
 from can.typechecking import AutoDetectedConfig, CanFilters
 
-from dbc.errors import BusError
+from dbc.errors import (
+    BusArgumentError,
+    BusInitError,
+    BusOperationError,
+    BusTimeoutError,
+)
 from transport.channel import (
     DEFAULT_CHANNEL,
     STALE_ERRNOS,
@@ -163,10 +168,10 @@ class HilBus(can.BusABC):
         if member_stall_s is not None and not (
             isinstance(member_stall_s, (int, float)) and member_stall_s >= 0
         ):
-            raise BusError(f"hilbus: member_stall_s = {member_stall_s!r}: expected seconds >= 0 "
-                           "or None")
+            raise BusArgumentError(f"hilbus: member_stall_s = {member_stall_s!r}: expected "
+                                   "seconds >= 0 or None")
         if not hasattr(socket, "AF_UNIX") or not hasattr(os, "getuid"):
-            raise BusError("hilbus needs Unix domain sockets (not available on this OS)")
+            raise BusInitError("hilbus needs Unix domain sockets (not available on this OS)")
         name = check_channel(DEFAULT_CHANNEL if channel is None else channel)
         path = new_member_path(bus_root() / name)
         sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
@@ -209,9 +214,11 @@ class HilBus(can.BusABC):
         """Send ``msg`` to every other member; blocks while a receiver's queue is full.
 
         ``timeout``: None waits as long as it takes, 0 never waits, > 0 waits at most that
-        long in total; on expiry raises :class:`can.CanOperationError` (the frame may have
-        reached some members). Raises BusError for a frame that cannot exist
-        (data > 64 bytes, or > 8 without ``is_fd``).
+        long in total; on expiry raises :class:`~dbc.errors.BusTimeoutError` (the frame may
+        have reached some members). Raises :class:`~dbc.errors.BusOperationError` for a
+        frame that cannot exist (data > 64 bytes, or > 8 without ``is_fd``), on a bus shut
+        down or listen-only, or if a member's socket fails. Both are
+        :class:`can.CanOperationError`.
         """
         self._check_can_send()
         record = encode(msg, time.time())
@@ -238,9 +245,9 @@ class HilBus(can.BusABC):
 
     def _check_can_send(self) -> None:
         if self._closed:
-            raise can.CanOperationError("hilbus: send on a bus that was shut down")
+            raise BusOperationError("hilbus: send on a bus that was shut down")
         if self._state is BusState.PASSIVE:
-            raise can.CanOperationError("hilbus: send on a listen-only (passive) bus")
+            raise BusOperationError("hilbus: send on a listen-only (passive) bus")
 
     def _fan_out(self, datagram: bytes, deadline: float | None) -> None:
         """One datagram to every other member."""
@@ -276,12 +283,12 @@ class HilBus(can.BusABC):
                     self._peers.stale(peer.name)
                     return
                 if exc.errno != errno.ENOBUFS:
-                    raise can.CanOperationError(
+                    raise BusOperationError(
                         f"hilbus: send to member {peer.name} failed: {exc}"
                     ) from exc
                 full_retry = True  # macOS: receiver full, no way to wait for room
             if self._closed:  # set before shutdown() wakes us, so checked after any drain
-                raise can.CanOperationError("hilbus: bus shut down during send")
+                raise BusOperationError("hilbus: bus shut down during send")
             if peer.overrun or poll_ms(stall_deadline) == 0:
                 peer.overrun = True  # it has not read for member_stall_s: drop, as a CAN
                 self.overrun_drops += 1  # controller's full receive buffer does
@@ -289,7 +296,7 @@ class HilBus(can.BusABC):
                 return
             wait_ms = poll_ms(deadline)
             if wait_ms == 0:
-                raise can.CanOperationError(
+                raise BusTimeoutError(
                     f"hilbus: send timed out: member {peer.name} on channel "
                     f"{self.channel!r} is not reading"
                 )
@@ -329,14 +336,14 @@ class HilBus(can.BusABC):
     @state.setter
     def state(self, new_state: BusState) -> None:
         if new_state not in (BusState.ACTIVE, BusState.PASSIVE):
-            raise BusError(f"hilbus: state {new_state} unsupported (ACTIVE or PASSIVE)")
+            raise BusOperationError(f"hilbus: state {new_state} unsupported (ACTIVE or PASSIVE)")
         self._state = new_state
 
     def shutdown(self) -> None:
         """Leave the channel: unlink this member's socket file and close every socket.
 
         Threads blocked in ``recv()`` or in a ``send()`` waiting for a full member wake and
-        raise :class:`can.CanOperationError` (releasing the send lock)."""
+        raise :class:`~dbc.errors.BusOperationError` (releasing the send lock)."""
         if self._closed:
             return
         self._closed = True

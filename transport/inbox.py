@@ -29,8 +29,7 @@ import threading
 import time
 from collections import deque
 
-import can
-
+from dbc.errors import BusOperationError
 from transport.wire import DATAGRAM_MAX_B, HilMessage, decode, is_burst, split_burst
 
 MS_PER_S = 1000
@@ -96,11 +95,11 @@ class Inbox:
 
     def next_frame(self, deadline: float | None) -> HilMessage | None:
         """The next frame, waiting until ``deadline`` (monotonic s; None: for ever) for one;
-        None at the deadline. Raises can.CanOperationError once closed or on a failed read."""
+        None at the deadline. Raises BusOperationError once closed or on a failed read."""
         record: bytes | None
         while True:
             if self.closed:
-                raise can.CanOperationError("hilbus: receive on a bus that was shut down")
+                raise BusOperationError("hilbus: receive on a bus that was shut down")
             with self.lock:
                 if self._backlog:
                     rx_time, record = self._backlog.popleft()
@@ -110,7 +109,7 @@ class Inbox:
                     except BlockingIOError:
                         record = None
                     except OSError as exc:
-                        raise can.CanOperationError(f"hilbus: receive failed: {exc}") from exc
+                        raise BusOperationError(f"hilbus: receive failed: {exc}") from exc
             if record is None:
                 wait_ms = poll_ms(deadline)
                 if wait_ms == 0 or not self.poller.poll(wait_ms):

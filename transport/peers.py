@@ -24,8 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import can
-
+from dbc.errors import BusInitError, BusOperationError
 from transport import channel
 
 #: size asked for SO_SNDBUF/SO_RCVBUF; the kernel clamps it to its maximum.
@@ -62,14 +61,18 @@ class Peers:
     """The members of ``directory`` other than ``own_name``, connected and cached.
 
     ``own_fileno``: this member's socket, registered for POLLIN in every peer's poller (a
-    sender waiting for room keeps its own queue moving).
+    sender waiting for room keeps its own queue moving). Raises BusInitError if the
+    directory cannot be opened.
     """
 
     def __init__(self, directory: Path, own_name: str, own_fileno: int) -> None:
         self.directory = directory
         self._own_name = own_name
         self._own_fileno = own_fileno
-        self._dir_fd = os.open(directory, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+        try:
+            self._dir_fd = os.open(directory, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+        except OSError as exc:
+            raise BusInitError(f"hilbus: cannot open directory {directory}: {exc}") from exc
         self._by_name: dict[str, Peer] = {}
         #: the peers as a tuple, rebuilt when the set changes (iterated on every send)
         self.current: tuple[Peer, ...] = ()
@@ -82,7 +85,7 @@ class Peers:
         """The peers now: rescans the directory if it changed (or may have) since the last
         scan. ``rx_count``: how many datagrams this member has received so far (one that
         arrived since the last scan may come from a member not seen yet). Raises
-        can.CanOperationError if the directory cannot be listed."""
+        BusOperationError if the directory cannot be listed."""
         mtime = os.fstat(self._dir_fd).st_mtime_ns  # the cheapest change check per send
         if mtime == self._scan_mtime_ns:
             if not self._scan_unsettled:
@@ -97,7 +100,7 @@ class Peers:
         try:
             listing = os.listdir(self.directory)
         except OSError as exc:
-            raise can.CanOperationError(
+            raise BusOperationError(
                 f"hilbus: cannot list channel directory {self.directory}: {exc}"
             ) from exc
         names = {
@@ -122,7 +125,7 @@ class Peers:
             if exc.errno in channel.STALE_ERRNOS:
                 channel.remove_if_dead(self.directory, name)
                 return
-            raise can.CanOperationError(f"hilbus: cannot reach member {name}: {exc}") from exc
+            raise BusOperationError(f"hilbus: cannot reach member {name}: {exc}") from exc
         poller = select.poll()
         poller.register(self._own_fileno, select.POLLIN)
         poller.register(s.fileno(), select.POLLOUT)

@@ -16,8 +16,9 @@ briefly descheduled during a burst (a flood, a trace replay, a slow emulated CPU
 lose frames. ``SO_RCVBUFFORCE`` is used where the process may (CAP_NET_ADMIN), else
 ``SO_RCVBUF``, which the kernel caps at ``net.core.rmem_max``.
 
-Errors: a malformed spec, or a bus that cannot be opened, raises
-:class:`~dbc.errors.BusError` naming the spec.
+Errors: a malformed spec raises :class:`~dbc.errors.BusError`; a bus that cannot be opened
+raises :class:`~dbc.errors.BusInitError` (a :class:`can.CanInitializationError`); both name
+the spec.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from urllib.parse import parse_qsl
 
 import can
 
-from dbc.errors import BusError
+from dbc.errors import BusError, BusInitError
 
 DEFAULT_SOCKETCAN_CHANNEL = "vcan0"
 PORTABLE_INTERFACE = "hilbus"
@@ -116,7 +117,8 @@ def default_bus_spec(sys_net: Path = SYS_NET) -> str:
 def open_bus(spec: str | BusSpec, **kwargs: object) -> can.BusABC:
     """Open the python-can bus named by ``spec`` (``kwargs`` override its options).
 
-    Raises BusError naming the spec for a malformed spec or a bus that cannot be opened.
+    Raises BusError for a malformed spec, BusInitError if the bus cannot be opened; both
+    name the spec.
     """
     bs = spec if isinstance(spec, BusSpec) else BusSpec.parse(spec)
     options = {k: _coerce(v) for k, v in bs.options}
@@ -127,7 +129,7 @@ def open_bus(spec: str | BusSpec, **kwargs: object) -> can.BusABC:
         hint = ""
         if bs.interface == "socketcan" and getattr(exc, "errno", None) == errno.EAFNOSUPPORT:
             hint = " (this kernel has no SocketCAN: use the portable bus, e.g. --bus hilbus:NAME)"
-        raise BusError(f"cannot open bus {bs}: {exc}{hint}") from exc
+        raise BusInitError(f"cannot open bus {bs}: {exc}{hint}") from exc
     sock = getattr(bus, "socket", None)
     if bs.interface == "socketcan" and isinstance(sock, socket.socket):
         enlarge_receive_buffer(sock)

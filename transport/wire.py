@@ -13,7 +13,8 @@ Decoded frames are :class:`HilMessage` objects: a :class:`can.Message` whose
 the sender's transmission time [s, wall clock]; :func:`tx_timestamp_of` reads the latter
 from any message. A record that is not valid decodes to None (the receiver counts it);
 nothing here raises on received bytes. Encoding a frame that cannot exist (more than 8
-data bytes without FD, more than 64 with) raises :class:`~dbc.errors.BusError`.
+data bytes without FD, more than 64 with) raises :class:`~dbc.errors.BusOperationError`
+(python-can: the driver rejected a message that was meant to be sent).
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from typing import Any
 
 import can
 
-from dbc.errors import BusError
+from dbc.errors import BusOperationError
 
 #: wire header: tx time (s), arbitration ID, flags, DLC, data length.
 HEADER = struct.Struct("<dIBBB")
@@ -94,12 +95,12 @@ def tx_timestamp_of(msg: can.Message) -> float | None:
 
 
 def encode(msg: can.Message, tx_time_s: float) -> bytes:
-    """The record of ``msg`` sent at ``tx_time_s``; raises BusError for a frame that
+    """The record of ``msg`` sent at ``tx_time_s``; raises BusOperationError for a frame that
     cannot exist (data longer than 8 bytes without ``is_fd``, or than 64)."""
     data = b"" if msg.is_remote_frame or msg.data is None else bytes(msg.data)
     limit = DATA_MAX_B if msg.is_fd else CLASSIC_DATA_MAX_B
     if len(data) > limit:
-        raise BusError(
+        raise BusOperationError(
             f"hilbus: frame 0x{msg.arbitration_id:X} has {len(data)} data bytes, "
             f"more than {limit} ({'CAN FD' if msg.is_fd else 'classic CAN'})"
         )
