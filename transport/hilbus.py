@@ -305,7 +305,7 @@ class HilBus(can.BusABC):
                 wait_ms = stall_ms if wait_ms is None else min(wait_ms, stall_ms)
             if full_retry:  # only our own socket can wake us: cap the wait
                 wait_ms = FULL_RETRY_MS if wait_ms is None else min(wait_ms, FULL_RETRY_MS)
-                events = dict(self._inbox.poller.poll(wait_ms))
+                events = dict(self._peers.own_poller.poll(wait_ms))  # never the inbox's
             else:
                 events = dict(peer.poller.poll(wait_ms))
             if events.get(self._inbox.fileno, 0) & select.POLLIN:

@@ -9,7 +9,8 @@ seen yet). A member whose socket refuses (``ECONNREFUSED``/``ENOENT``: its proce
 without shutting down) is stale: it is dropped, and its socket file unlinked if the pid in
 its name is no longer alive.
 
-Not thread-safe on its own: the owning bus calls it under its send lock. Times: ``_s``
+Not thread-safe on its own: the owning bus calls it, and polls its pollers, under its send
+lock only; none of them is the receive side's. Times: ``_s``
 seconds, ``_ns`` nanoseconds.
 """
 
@@ -74,6 +75,11 @@ class Peers:
         except OSError as exc:
             raise BusInitError(f"hilbus: cannot open directory {directory}: {exc}") from exc
         self._by_name: dict[str, Peer] = {}
+        #: waits for our own socket only: the send side's own poller (a receiving thread may
+        #: be blocked on the inbox's at the same time, and one poll object must never be
+        #: polled by two threads at once: CPython raises "concurrent poll() invocation")
+        self.own_poller = select.poll()
+        self.own_poller.register(own_fileno, select.POLLIN)
         #: the peers as a tuple, rebuilt when the set changes (iterated on every send)
         self.current: tuple[Peer, ...] = ()
         self._scan_mtime_ns: int | None = None
