@@ -14,9 +14,21 @@ Channel names are restricted to ``[A-Za-z0-9_.-]+`` (and not ``.``/``..``) so th
 escape the directory (else :class:`~dbc.errors.BusArgumentError`). The socket path must
 fit ``sun_path`` (107 bytes on Linux, 103 elsewhere; else BusArgumentError).
 
+Lifetime: a channel directory exists while the channel has members. A member joining
+creates it (:func:`join`); the last member leaving removes it (:func:`leave`: ``rmdir``,
+which only succeeds on an empty directory, so a member that joined meanwhile keeps it).
+A member that joins while the last one leaves may find its directory gone between
+creating it and binding its socket in it: it creates it again and retries. Once its
+socket is bound the directory is not empty, so nobody can remove it under a member.
+Members of processes that died without leaving, and channel directories left empty by
+them, are removed by :func:`sweep`, which every joining member runs over the user's
+channels: a socket file goes when the process in its name is dead *and* nothing is bound
+to it (a connection is refused), a directory when it is then empty. Files that are not
+member sockets are never touched.
+
 In: channel names, member socket names. Out: paths, a bound member socket
-(:func:`bind_member`), the pid in a member's name and whether it is alive, the channels
-that have live members (:func:`live_channels`). Assumes one host and one user.
+(:func:`join`), the pid in a member's name and whether it is alive, the channels that have
+live members (:func:`live_channels`). Assumes one host and one user.
 """
 
 from __future__ import annotations
@@ -44,6 +56,9 @@ PERMISSION_BITS = 0o7777
 GROUP_OTHER_BITS = 0o077
 SUN_PATH_MAX_LINUX_B = 107
 SUN_PATH_MAX_OTHER_B = 103
+#: times a joining member recreates a channel directory that a leaving member removed
+#: between its creation and the bind (each retry needs another member to leave meanwhile)
+JOIN_ATTEMPTS = 16
 
 #: errors of a member socket whose process is gone (or never was there)
 STALE_ERRNOS = frozenset(
@@ -114,17 +129,25 @@ def sun_path_max_b() -> int:
 
 
 def secure_dir(path: Path) -> None:
-    """Create ``path`` with mode 0o700, or check an existing one is ours and private."""
+    """Create ``path`` with mode 0o700, or check an existing one is ours and private.
+
+    Raises BusInitError naming the path if it cannot be created or is not private, and
+    FileNotFoundError if it (or its parent) was removed meanwhile (the caller retries).
+    """
     try:
         os.mkdir(path, DIR_MODE)
     except FileExistsError:
         pass
+    except FileNotFoundError:
+        raise
     except OSError as exc:
         raise BusInitError(f"hilbus: cannot create directory {path}: {exc.strerror}") from exc
     else:
         os.chmod(path, DIR_MODE)  # the umask may have taken bits away
     try:
         st = os.lstat(path)
+    except FileNotFoundError:
+        raise
     except OSError as exc:
         raise BusInitError(f"hilbus: cannot inspect directory {path}: {exc.strerror}") from exc
     if not is_private_dir(st):
@@ -144,18 +167,45 @@ def is_private_dir(st: os.stat_result) -> bool:
     return _isdir(st) and st.st_uid == os.getuid() and (st.st_mode & GROUP_OTHER_BITS) == 0
 
 
-def bind_member(sock: socket.socket, path: Path) -> None:
+def join(sock: socket.socket, path: Path) -> None:
     """Create the channel's directories if needed and bind ``sock`` at ``path`` (mode
-    0o600); raises BusInitError naming the path if either fails."""
-    secure_dir(path.parent.parent)
-    secure_dir(path.parent)
-    try:
-        sock.bind(os.fspath(path))
-        os.chmod(path, SOCKET_MODE)
-    except OSError as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(path)
-        raise BusInitError(f"hilbus: cannot bind {path}: {exc}") from exc
+    0o600), creating the channel directory again if the last member removed it meanwhile.
+    Raises BusInitError naming the path if either fails."""
+    for _attempt in range(JOIN_ATTEMPTS):
+        try:
+            secure_dir(path.parent.parent)
+            secure_dir(path.parent)
+            sock.bind(os.fspath(path))
+        except FileNotFoundError:
+            continue  # the last member left and removed the directory: create it again
+        except BusInitError:
+            raise
+        except OSError as exc:
+            remove_if_empty(path.parent)  # checked private and ours: if we made it, unmake it
+            raise BusInitError(f"hilbus: cannot bind {path}: {exc}") from exc
+        try:
+            os.chmod(path, SOCKET_MODE)
+        except OSError as exc:
+            leave(path)
+            raise BusInitError(f"hilbus: cannot restrict {path} to its owner: {exc}") from exc
+        return
+    raise BusInitError(
+        f"hilbus: cannot join {path.parent}: it was removed {JOIN_ATTEMPTS} times while "
+        "joining (members leaving as fast as this one joins)"
+    )
+
+
+def leave(path: Path) -> None:
+    """Unlink member socket ``path``, then its channel directory if that is now empty."""
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(path)
+    remove_if_empty(path.parent)
+
+
+def remove_if_empty(directory: Path) -> None:
+    """``rmdir`` ``directory``: removed if empty, left alone otherwise (or if gone)."""
+    with contextlib.suppress(OSError):  # ENOTEMPTY: a member is (or joined) there
+        os.rmdir(directory)
 
 
 def member_pid(name: str) -> int | None:
@@ -181,6 +231,40 @@ def remove_if_dead(directory: Path, name: str) -> None:
     if pid is not None and not pid_alive(pid):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(directory / name)
+
+
+def _refuses(path: Path) -> bool:
+    """True if nothing is bound to socket file ``path`` (or it is gone, or no socket)."""
+    with socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM) as probe:
+        try:
+            probe.connect(os.fspath(path))
+        except OSError as exc:
+            return exc.errno in STALE_ERRNOS
+    return False
+
+
+def sweep(root: Path) -> None:
+    """Remove what dead processes left in ``root`` (the user's bus directory): member
+    sockets whose process is dead and that nobody is bound to, then channel directories
+    that are empty. Skips anything that is not a private directory of ours; never raises."""
+    try:
+        channels = os.listdir(root)
+    except OSError:
+        return
+    for ch in channels:
+        directory = root / ch
+        try:
+            if not is_channel_name(ch) or not is_private_dir(os.lstat(directory)):
+                continue
+            names = os.listdir(directory)
+        except OSError:
+            continue
+        for name in names:
+            pid = member_pid(name)
+            if pid is not None and not pid_alive(pid) and _refuses(directory / name):
+                with contextlib.suppress(OSError):
+                    os.unlink(directory / name)
+        remove_if_empty(directory)
 
 
 def live_channels() -> list[str]:

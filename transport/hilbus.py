@@ -112,12 +112,15 @@ from dbc.errors import (
 from transport.channel import (
     DEFAULT_CHANNEL,
     STALE_ERRNOS,
-    bind_member,
     bus_root,
     check_channel,
+    join,
+    leave,
     live_channels,
     member_pid,
     new_member_path,
+    remove_if_empty,
+    sweep,
 )
 from transport.inbox import MS_PER_S, Inbox, deadline_of, poll_ms
 from transport.peers import MTIME_SETTLE_S, Peer, Peers, set_buffers
@@ -178,13 +181,17 @@ class HilBus(can.BusABC):
         try:
             set_buffers(sock)
             inbox = Inbox(sock, os.fsencode(path), name)
-            bind_member(sock, path)
+            join(sock, path)
+        except BaseException:
+            sock.close()
+            raise
+        try:
             peers = Peers(path.parent, path.name, sock.fileno())
         except BaseException:
             sock.close()
-            with contextlib.suppress(OSError):
-                os.unlink(path)
+            leave(path)
             raise
+        sweep(path.parent.parent)  # what dead processes left behind (see transport.channel)
         self.channel = name
         self.channel_info = f"hilbus channel {name!r} ({path})"
         self.directory = path.parent
@@ -340,7 +347,8 @@ class HilBus(can.BusABC):
         self._state = new_state
 
     def shutdown(self) -> None:
-        """Leave the channel: unlink this member's socket file and close every socket.
+        """Leave the channel: unlink this member's socket file, close every socket, and
+        remove the channel directory if no member is left in it.
 
         Threads blocked in ``recv()`` or in a ``send()`` waiting for a full member wake and
         raise :class:`~dbc.errors.BusOperationError` (releasing the send lock)."""
@@ -356,6 +364,7 @@ class HilBus(can.BusABC):
             with self._tx_lock:
                 self._peers.close()
             self._inbox.release()
+            remove_if_empty(self.directory)  # the last member leaving removes the channel
 
     @staticmethod
     def _detect_available_configs() -> Sequence[AutoDetectedConfig]:
