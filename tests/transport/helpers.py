@@ -135,7 +135,7 @@ class Lines:
     def wait_for(self, predicate_text: str, deadline_s: float = DEADLINE_S) -> str:
         """The first line containing predicate_text; fails at EOF or the deadline."""
         deadline = time.monotonic() + deadline_s
-        seen = []
+        seen: list[str] = []
         while True:
             left = deadline - time.monotonic()
             assert left > 0, f"no line with {predicate_text!r} within {deadline_s} s: {seen}"

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import uuid
 from pathlib import Path
+from typing import Any
 
 import can
 import pytest
@@ -30,10 +31,10 @@ SEND_TIMEOUT_S = 0.05
     ids=["bad-channel-name", "path-too-long", "bad-member-stall"],
 )
 def test_a_bad_argument_is_a_python_can_initialization_error_and_a_value_error(
-    runtime: Path, kwargs: dict[str, object]
+    runtime: Path, kwargs: dict[str, Any]
 ) -> None:
     """An argument out of range, through can.Bus as any python-can program opens a bus."""
-    args: dict[str, object] = {"channel": f"e-{uuid.uuid4().hex[:8]}", **kwargs}
+    args: dict[str, Any] = {"channel": f"e-{uuid.uuid4().hex[:8]}", **kwargs}
     with pytest.raises(can.CanInitializationError) as info:
         can.Bus(interface="hilbus", **args)
     assert isinstance(info.value, ValueError) and isinstance(info.value, BusError)
@@ -49,22 +50,25 @@ def test_an_unusable_directory_is_a_python_can_initialization_error(runtime: Pat
 
 
 def test_failed_operations_are_python_can_operation_errors(channel: str) -> None:
-    """A frame that cannot exist, a listen-only send, and sends and receives after shutdown
-    raise CanOperationError (the project's BusError too)."""
+    """A frame that cannot exist, a listen-only send, an unsupported state, and sends and
+    receives after shutdown raise CanOperationError (the project's BusError too)."""
     with HilBus(channel) as a:
-        calls = [lambda: a.send(can.Message(arbitration_id=1, data=bytes(9)))]
-        a.state = can.BusState.PASSIVE
-        calls.append(lambda: a.send(can.Message(arbitration_id=1)))
-        for call in calls:
-            with pytest.raises(can.CanOperationError) as info:
-                call()
-            assert isinstance(info.value, BusError)
-        with pytest.raises(can.CanOperationError, match="unsupported"):
-            a.state = can.BusState.ERROR
-    for call in (lambda: a.send(can.Message()), lambda: a.recv(timeout=0)):
-        with pytest.raises(can.CanOperationError, match="shut down") as info:
-            call()
+        with pytest.raises(can.CanOperationError, match="9 data bytes") as info:
+            a.send(can.Message(arbitration_id=1, data=bytes(9)))
         assert isinstance(info.value, BusError)
+        a.state = can.BusState.PASSIVE
+        with pytest.raises(can.CanOperationError, match="listen-only") as info:
+            a.send(can.Message(arbitration_id=1))
+        assert isinstance(info.value, BusError)
+        with pytest.raises(can.CanOperationError, match="unsupported") as info:
+            a.state = can.BusState.ERROR
+        assert isinstance(info.value, BusError)
+    with pytest.raises(can.CanOperationError, match="shut down") as info:
+        a.send(can.Message())
+    assert isinstance(info.value, BusError)
+    with pytest.raises(can.CanOperationError, match="shut down") as info:
+        a.recv(timeout=0)
+    assert isinstance(info.value, BusError)
 
 
 def test_a_send_that_times_out_is_a_python_can_timeout_error(
