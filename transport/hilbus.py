@@ -27,7 +27,9 @@ Design
 * Each member (each :class:`HilBus` object) binds its own ``AF_UNIX``/``SOCK_DGRAM``
   socket file ``<pid>-<random hex>.sock`` in the channel directory
   ``<runtime>/thruster-hil-<uid>/<channel>/`` (:mod:`transport.channel`: layout,
-  permissions, path limits).
+  permissions, path limits). The directory lives as long as the channel has members: the
+  last one to leave removes it, and a joining member sweeps away what processes that died
+  without leaving left behind.
 * Sending a frame writes one datagram to every *other* member's socket, through a socket
   connected to it (:mod:`transport.peers`: the cached member list, stale members).
 * Reliable and ordered: datagrams on a Unix socket are never lost, and each receiver's
@@ -68,6 +70,15 @@ makes a member listen-only (``send`` raises); ``fileno()`` is readable whenever 
 waits, so :class:`can.Notifier` (threads or asyncio) works. ``send`` may be called from
 several threads (periodic tasks); ``recv`` from one thread at a time, as with any
 python-can bus.
+
+Errors
+------
+python-can's, and the project's (:mod:`dbc.errors`): a bus that cannot be opened raises
+:class:`~dbc.errors.BusInitError` (a :class:`can.CanInitializationError`; for an argument
+out of range :class:`~dbc.errors.BusArgumentError`, also a ValueError), a failed or refused
+send or receive :class:`~dbc.errors.BusOperationError` (a :class:`can.CanOperationError`;
+a send that times out :class:`~dbc.errors.BusTimeoutError`, also a
+:class:`can.CanTimeoutError`). All are :class:`~dbc.errors.BusError`.
 
 Limits
 ------
