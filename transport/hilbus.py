@@ -138,7 +138,7 @@ from transport.peers import MTIME_SETTLE_S, Peer, Peers, set_buffers
 from transport.wire import BURST_MAX_RECORDS, HilMessage, encode, own_copy, tx_timestamp_of
 
 # the plugin's public names (the frame type and its reader are defined in transport.wire)
-__all__ = [
+__all__ = (
     "DEFAULT_CHANNEL",
     "INTERFACE_NAME",
     "MEMBER_STALL_S",
@@ -146,7 +146,7 @@ __all__ = [
     "HilBus",
     "HilMessage",
     "tx_timestamp_of",
-]
+)
 
 INTERFACE_NAME = "hilbus"
 #: wait between retries where the OS cannot tell when a full receiver has room (macOS).
