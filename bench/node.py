@@ -49,10 +49,10 @@ from bench.wire.receipt import Arrival, Receipt
 from bench.wire.timing import bus_off_recovery_ns, frame_bits
 from bench.wire.trace import TraceRecorder
 from bench.wire.wire import Wire
-from dbc.bus import recv_spinning
 from dbc.codec import Decoded, Encoder, FrameChecker
 from dbc.errors import RunError
 from dbc.icd import BENCH, FSW, Icd
+from transport.lockstep import recv_spinning
 
 FAULT_RNG_STREAM = 0xFA  # spawn key of the wire's fault-injection random stream
 STARTUP_POLL_S = 0.2
@@ -113,7 +113,7 @@ class BenchNode:
         self.receipt = Receipt(icd, checker, rng, self.wire.fault_counts, active)
         self.results = Results(sc, icd, run_dir, mode, seed, bus_spec, self.n_thr,
                                round(sc.valve.open_delay_s * NS_PER_S))
-        self.lockstep_spin_s = 0.0  # poll this long before blocking for commands (dbc.bus)
+        self.lockstep_spin_s = 0.0  # poll this long before blocking (transport.lockstep)
         self.fsw_alive: Callable[[], bool] | None = None
         self.started = False  # the run has begun (live fault commands are taken)
         self.consecutive_stalls = 0

@@ -13,7 +13,7 @@ For each bus (``hilbus``, python-can ``virtual`` as the in-process baseline, and
 * throughput: this process sends M frames (default 100 000) back to back; the peer counts
   them (checking their sequence numbers) and reports when it has seen the last one.
   Frames/s over that span, plus frames lost or out of order; once one frame per send, once
-  8 per ``dbc.bus.send_frames`` call (one datagram on hilbus).
+  8 per ``transport.lockstep.send_frames`` call (one datagram on hilbus).
 
 Usage: ``python benchmarks/bus_roundtrip.py [--rtt-n 5000] [--rtt-runs 3]
 [--throughput-n 100000]`` (about 7 s here with the defaults, well under 30 s).
@@ -39,7 +39,8 @@ from pathlib import Path
 
 import can
 
-from dbc.bus import open_bus, send_frames
+from transport.lockstep import send_frames
+from transport.spec import open_bus
 
 PING_ID = 0x100
 PONG_ID = 0x101
@@ -54,7 +55,7 @@ REPORT = struct.Struct("<II")
 RTT_N_DEFAULT = 5000
 RTT_RUNS_DEFAULT = 3
 THROUGHPUT_N_DEFAULT = 100_000
-WARMUP_S = 1.5  # > dbc.hilbus.MTIME_SETTLE_S: membership caches have settled
+WARMUP_S = 1.5  # > transport.hilbus.MTIME_SETTLE_S: membership caches have settled
 STARTUP_TIMEOUT_S = 20.0
 REPLY_TIMEOUT_S = 10.0
 SYS_NET = Path("/sys/class/net")
@@ -160,8 +161,8 @@ def measure(bus: can.BusABC, cfg: Config) -> dict[str, object]:
             "p50_of_each_run": [r["p50"] for r in runs],
         },
         "throughput": _throughput(bus, cfg.throughput_n, 1),
-        # frames of one instant handed over together (dbc.bus.send_frames: one datagram on
-        # hilbus, one send each elsewhere), as a lockstep bench does with its samples
+        # frames of one instant handed over together (transport.lockstep.send_frames: one
+        # datagram on hilbus, one send each elsewhere), as a lockstep bench does with its samples
         f"throughput_in_bursts_of_{BURST_FRAMES}": _throughput(bus, cfg.throughput_n,
                                                                BURST_FRAMES),
     }

@@ -17,13 +17,14 @@ import os
 import sys
 from pathlib import Path
 
-from dbc.bus import available_cpus, default_bus_spec, lockstep_spin_s, mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.database import load_database
 from dbc.errors import BusError, ConfigError
 from flight_sw.config import build_computer, load_config
 from flight_sw.node import FlightNode
 from flight_sw.rx_log import ReceiveLog
+from transport.lockstep import available_cpus, lockstep_spin_s
+from transport.spec import default_bus_spec, mode_options, open_bus
 
 EXIT_BAD_INPUT = 2
 

@@ -39,7 +39,6 @@ import can
 import numpy as np
 from cantools.database.can import Database
 
-from dbc.bus import recv_spinning, send_frames
 from dbc.codec import Decoded, Encoder, FrameChecker, Reject
 from dbc.icd import BENCH, FSW, Icd
 from dbc.quaternion import pack_quaternion, unpack_quaternion
@@ -54,6 +53,7 @@ from flight_sw.stats import (
     spread,
     write_json_atomic,
 )
+from transport.lockstep import recv_spinning, send_frames
 
 HEARTBEAT_RETRY_S = 1.0  # silence before the next FSW_STATUS heartbeat, until the first SYNC
 # Lockstep, once cycling: the bench is the time master and may be silent for a while without
@@ -109,7 +109,7 @@ class FlightNode:
         self._stop = False
         self._waiting = False  # blocked in the bus receive: a stop signal may interrupt
         self.lockstep_silence_heartbeat_s = LOCKSTEP_SILENCE_HEARTBEAT_S
-        self.lockstep_spin_s = 0.0  # lockstep: poll this long before blocking (dbc.bus)
+        self.lockstep_spin_s = 0.0  # lockstep: poll this long before blocking (transport.lockstep)
         self.restart_quiet_ns = RESTART_QUIET_NS
         self._last_sync: int | None = None
         self._pending_seen: set[str] = set()
@@ -175,7 +175,7 @@ class FlightNode:
         self.stats.sent[name] = self.stats.sent.get(name, 0) + 1
 
     def _send_held(self) -> None:
-        """The cycle's frames, in the order encoded, as one burst (dbc.bus.send_frames)."""
+        """The cycle's frames, in the order encoded, as one burst (lockstep.send_frames)."""
         held = self._held or []
         send_frames(self.bus, [msg for _name, msg in held])
         for name, _msg in held:

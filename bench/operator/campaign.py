@@ -4,13 +4,13 @@
 (also ``thruster-hil campaign``). Each run is the scenario with one ``[[faults]]`` entry
 appended, started as its own ``thruster-hil run`` process on a private portable-bus channel,
 ``--jobs`` at a time (with more processes than CPUs, their lockstep waits block at once
-instead of polling first: see dbc.bus). The flight software's FDIR report (FSW_FDIR, in each
-summary.json) gives detection and isolation. Out, in DIR: ``campaign.csv`` (one row per run:
-thruster, kind, detected, detection time after the fault, isolated thruster, isolation
-correct, expectations met, final attitude and position error, propellant), ``campaign.json``
-and ``campaign.png`` (detection time per thruster and kind), plus every run folder. Exit 0
-if every run detected and isolated its failure and met the scenario's expectations, 1 if
-not, 2 on bad input, 3 if a run could not complete.
+instead of polling first: see transport.lockstep). The flight software's FDIR report
+(FSW_FDIR, in each summary.json) gives detection and isolation. Out, in DIR:
+``campaign.csv`` (one row per run: thruster, kind, detected, detection time after the
+fault, isolated thruster, isolation correct, expectations met, final attitude and position
+error, propellant), ``campaign.json`` and ``campaign.png`` (detection time per thruster and
+kind), plus every run folder. Exit 0 if every run detected and isolated its failure and met
+the scenario's expectations, 1 if not, 2 on bad input, 3 if a run could not complete.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from pathlib import Path
 from typing import Any
 
 from bench.scenario.load import load_scenario
-from dbc.bus import LOCKSTEP_SPIN_ENV, available_cpus
 from dbc.errors import ConfigError, RunError
+from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
 KINDS = ("stuck_closed", "stuck_open")
 DEFAULT_FAULT_TIME_S = 10.0

@@ -18,8 +18,8 @@ import time
 from pathlib import Path
 from typing import Any
 
-from dbc.bus import BusSpec, default_bus_spec
 from dbc.errors import BusError, ConfigError, IcdError, RunError
+from transport.spec import BusSpec, default_bus_spec
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it

@@ -19,9 +19,9 @@ import time
 import can
 import numpy as np
 
-from dbc.bus import open_bus
 from dbc.codec import Encoder
 from dbc.database import load_database
+from transport.spec import open_bus
 
 CAUSES = ("unknown_id", "error_frame", "crc", "dlc", "remote_frame")
 TARGETS = {"FSW": "IMU_ACCEL", "BENCH": "FSW_ATT_EST"}  # a message each side consumes

@@ -16,11 +16,11 @@ from dataclasses import dataclass
 import can
 
 from dbc import e2e
-from dbc.bus import open_bus
 from dbc.codec import Encoder, FrameChecker
 from dbc.database import load_database
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 from dbc.icd import Icd
+from transport.spec import open_bus
 
 INJECT_SOURCE = "thruster-hil inject"
 DEFAULT_TIMEOUT_S = 5.0

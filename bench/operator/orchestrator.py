@@ -39,12 +39,13 @@ from bench.results.counts import frame_table, merge_counts, zero_unheard
 from bench.results.metrics import pointing_metrics
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
-from dbc.bus import available_cpus, lockstep_spin_s, mode_options, open_bus
 from dbc.codec import cycle_time_ns
 from dbc.database import load_database
 from dbc.errors import ConfigError, RefusedConfigError, RunError
-from dbc.hilbus import MEMBER_STALL_S
 from dbc.icd import Icd
+from transport.hilbus import MEMBER_STALL_S
+from transport.lockstep import available_cpus, lockstep_spin_s
+from transport.spec import mode_options, open_bus
 
 DEFAULT_FSW_CMD = (
     f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
@@ -209,7 +210,7 @@ def _run_bench(
     """The bench process: run, then write summary.json and plots (whatever happened).
 
     ``spin_s``: lockstep, how long to poll for the flight software's answer before blocking
-    (dbc.bus.lockstep_spin_s; our flight software works its own out the same way).
+    (transport.lockstep.lockstep_spin_s; our flight software works its own out the same way).
     """
     out = opts.out
     stats = out / "fsw_stats.json"

@@ -118,8 +118,8 @@ def pytest_configure(config: pytest.Config) -> None:
     """Check ``--hil-bus`` early, so a typo is a usage error and not a failed test."""
     bus = config.getoption("--hil-bus", default=None)
     if bus:
-        from dbc.bus import BusSpec
         from dbc.errors import BusError
+        from transport.spec import BusSpec
 
         try:
             BusSpec.parse(bus)
@@ -155,8 +155,8 @@ class HilRunOptions:
         if self.mode not in MODES:
             raise _bad("mode", self.mode, f"one of {', '.join(MODES)}")
         if self.bus is not None:
-            from dbc.bus import BusSpec
             from dbc.errors import BusError
+            from transport.spec import BusSpec
 
             try:
                 BusSpec.parse(self.bus)

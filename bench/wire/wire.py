@@ -32,9 +32,9 @@ from bench.station.faults import FaultSpec
 from bench.wire.fate import NO_FATE, Fate, flip, frame_fate
 from bench.wire.timing import INTERMISSION_BITS, BusArbiter, Delivery, frame_bits, wire_time_ns
 from bench.wire.trace import NAN, TraceRecorder
-from dbc.bus import send_frames
 from dbc.codec import Encoder
 from dbc.icd import BENCH, Icd
+from transport.lockstep import send_frames
 
 NS_PER_S = 1_000_000_000
 BABBLE_DLC = 8
@@ -147,7 +147,7 @@ class Wire:
         self.arbiter.bus_off(node, from_ns, to_ns)
 
     def release(self) -> None:
-        """Hand the held frames to the bus, in order, together (dbc.bus.send_frames)."""
+        """Hand the held frames to the bus, in order, together (transport.lockstep.send_frames)."""
         if self._held:
             send_frames(self.bus, self._held)
             self._held = []

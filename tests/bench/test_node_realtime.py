@@ -24,9 +24,9 @@ import can
 from bench.node import NS_PER_S, RT_FRAMES_PER_PASS, BenchNode, Clock
 from bench.scenario.load import load_scenario
 from bench.station.plant import STEP_NS
-from dbc.bus import open_bus
 from dbc.codec import Encoder, cycle_time_ns
 from dbc.database import load_database
+from transport.spec import open_bus
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 OVERLOAD_SPEEDUP = 20  # the bench's clock against the wall clock: beyond what it keeps up with

@@ -9,9 +9,9 @@ import can
 
 from bench.node import BenchNode
 from bench.scenario.load import load_scenario
-from dbc.bus import open_bus
 from dbc.codec import Encoder
 from dbc.database import load_database
+from transport.spec import open_bus
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 UNKNOWN_ID = 0x7FE  # not in the DBC

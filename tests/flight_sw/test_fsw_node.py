@@ -23,8 +23,8 @@ from dbc.codec import Encoder, FrameChecker, cycle_time_ns
 from dbc.database import load_database
 from dbc.quaternion import pack_quaternion
 from flight_sw.config import build_computer
-from flight_sw.modes import FdirFlag, Mode, SensorFlag
 from flight_sw.frames import FULL_ON_OVERLAP_S
+from flight_sw.modes import FdirFlag, Mode, SensorFlag
 from flight_sw.node import HEARTBEAT_RETRY_S, RESTART_QUIET_NS, FlightNode
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"

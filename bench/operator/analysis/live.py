@@ -34,11 +34,11 @@ import can
 from bench.operator.analysis.defaults import DEFAULT_FIRST_FRAME_TIMEOUT_S
 from bench.operator.analysis.timing import FrameTable, RunTiming, TimingOptions, dbc_bitrate_bps
 from bench.wire.timing import frame_bits
-from dbc.bus import open_bus
 from dbc.database import load_database
 from dbc.e2e import COUNTER_BYTE, COUNTER_MASK
 from dbc.errors import ConfigError, RunError
-from dbc.hilbus import tx_timestamp_of
+from transport.hilbus import tx_timestamp_of
+from transport.spec import open_bus
 
 LIVE_SOURCE = "timing --live"
 NAN = float("nan")

@@ -28,7 +28,7 @@ from bench.results.writers import CHAIN_COLUMNS
 from bench.wire.trace import FRAME_COLUMNS
 from dbc.database import load_database
 from dbc.errors import ConfigError, RunError
-from dbc.hilbus import HilMessage
+from transport.hilbus import HilMessage
 
 # Tolerances, named: float sums of seconds near 0.1 s carry ~1e-17 s error each.
 TIME_TOL_S = 1e-12

