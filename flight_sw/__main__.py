@@ -4,7 +4,8 @@ Opens the bus, builds the flight computer from ``--config`` and runs it in locks
 cycle per SYNC) or realtime (own timer) until SIGTERM/SIGINT. ``--check`` only validates
 the configuration. ``--rx-log`` (realtime) logs when each frame arrived
 (:mod:`flight_sw.rx_log`). Exit codes: 0 ok, 2 bad configuration, bus or log path (and
-the reason, as ``{"refused": ...}``, in the ``--stats`` file).
+the reason, as a ``thruster-hil/fsw-refusal`` record of dbc.contract, in the ``--stats``
+file).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import sys
 from pathlib import Path
 
 from dbc.codec import cycle_time_ns
+from dbc.contract import EXIT_REFUSED, FswRefusal
 from dbc.database import load_database
 from dbc.errors import BusError, ConfigError
 from flight_sw.config import build_computer, load_config
@@ -26,14 +28,12 @@ from flight_sw.rx_log import ReceiveLog
 from transport.lockstep import available_cpus, lockstep_spin_s
 from transport.spec import default_bus_spec, mode_options, open_bus
 
-EXIT_BAD_INPUT = 2
 
-
-def _write_refusal(stats: str | None, why: str) -> None:
-    """``{"refused": why}`` as the statistics file: the bench reports it instead of a crash."""
+def _write_refusal(stats: str | None, refusal: FswRefusal) -> None:
+    """The refusal record (dbc.contract) as the statistics file: the bench reports it."""
     if stats:
         with contextlib.suppress(OSError):  # the message is on stderr as well
-            Path(stats).write_text(json.dumps({"refused": why}) + "\n", encoding="utf-8")
+            Path(stats).write_text(json.dumps(refusal.to_json()) + "\n", encoding="utf-8")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -66,16 +66,22 @@ def main(argv: list[str] | None = None) -> int:
         spin_s = lockstep_spin_s(available_cpus(), os.environ) if args.mode == "lockstep" else 0.0
         spec = args.bus or default_bus_spec()
         bus = open_bus(spec, **mode_options(spec, args.mode))
-    except (ConfigError, BusError) as exc:
+    except ConfigError as exc:
         print(f"flight_sw: error: {exc}", file=sys.stderr)
-        _write_refusal(args.stats, str(exc))
-        return EXIT_BAD_INPUT
+        _write_refusal(args.stats, FswRefusal.of(exc))
+        return EXIT_REFUSED
+    except BusError as exc:
+        print(f"flight_sw: error: {exc}", file=sys.stderr)
+        _write_refusal(args.stats, FswRefusal("command line", "--bus", args.bus, str(exc)))
+        return EXIT_REFUSED
     try:
         rx_log = ReceiveLog(Path(args.rx_log)) if args.rx_log and args.mode == "realtime" else None
     except OSError as exc:
         print(f"flight_sw: error: --rx-log {args.rx_log}: {exc}", file=sys.stderr)
+        _write_refusal(args.stats, FswRefusal("command line", "--rx-log", args.rx_log,
+                                              f"a writable file ({exc.strerror or exc})"))
         bus.shutdown()
-        return EXIT_BAD_INPUT
+        return EXIT_REFUSED
     node = FlightNode(db, bus, computer, Path(args.stats) if args.stats else None, rx_log)
     node.lockstep_spin_s = spin_s
     node.install_signal_handlers()

@@ -40,6 +40,7 @@ import numpy as np
 from cantools.database.can import Database
 
 from dbc.codec import Decoded, Encoder, FrameChecker, Reject
+from dbc.contract import STATS_SCHEMA, VERSION
 from dbc.icd import BENCH, FSW, Icd
 from dbc.quaternion import pack_quaternion, unpack_quaternion
 from flight_sw.clock import MonotonicClock
@@ -452,6 +453,8 @@ class FlightNode:
         st = self.stats
         received = self.checker.summary()
         data: dict[str, Any] = {
+            "schema": STATS_SCHEMA,
+            "version": VERSION,
             "cycles": st.cycles,
             "overruns": st.overruns,
             "sent": dict(sorted(st.sent.items())),

@@ -21,6 +21,7 @@ import selectors
 import shlex
 import shutil
 import signal
+import string
 import subprocess
 import sys
 import traceback
@@ -40,6 +41,7 @@ from bench.results.metrics import pointing_metrics
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
 from dbc.codec import cycle_time_ns
+from dbc.contract import EXIT_REFUSED, REFUSAL_SCHEMA, FswRefusal
 from dbc.database import load_database
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 from dbc.icd import Icd
@@ -54,8 +56,6 @@ DEFAULT_FSW_CMD = (
 FSW_TERM_TIMEOUT_S = 5.0
 EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH, EXIT_CHILD_BAD_INPUT = 0, 3, 4, 5
 EXIT_CHILD_INTERRUPTED = 6  # Ctrl-C: the run folder is complete, the parent re-raises it
-FSW_EXIT_BAD_INPUT = 2  # our flight software's exit code for a configuration it refuses
-FSW_ERROR_MARK = "error:"  # how its refusal line reads in fsw.log
 PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
 
@@ -79,17 +79,42 @@ class RunOptions:
                               f"at least one control period ({period_s} s)")
 
 
+PLACEHOLDERS = ("bus", "mode", "config", "stats", "run_dir", "rx_log")
+
+
 def _fsw_argv(template: str, opts: RunOptions, config: Path, stats: Path) -> list[str]:
+    """The flight software's command line: ``template`` split as a shell would, with its
+    placeholders (plain names of :data:`PLACEHOLDERS` only: no attribute, index, format
+    or conversion) replaced."""
+    values = {"bus": opts.bus, "mode": opts.mode, "config": str(config), "stats": str(stats),
+              "run_dir": str(opts.out), "rx_log": str(opts.out / RX_LOG_FILE)}
+    allowed = " ".join(f"{{{p}}}" for p in PLACEHOLDERS)
     try:
-        return [
-            a.format(bus=opts.bus, mode=opts.mode, config=config, stats=stats, run_dir=opts.out,
-                     rx_log=opts.out / RX_LOG_FILE)
-            for a in shlex.split(template)
-        ]
-    except (KeyError, IndexError, ValueError) as exc:
+        args = shlex.split(template)
+    except ValueError as exc:
         raise ConfigError("command line", "--fsw-cmd", template,
-                          f"placeholders among {{bus}} {{mode}} {{config}} {{stats}} {{run_dir}} "
-                          f"{{rx_log}} ({exc})") from exc
+                          f"a command line a shell can split ({exc})") from exc
+    out = []
+    for a in args:
+        parts = []
+        try:
+            parsed = list(string.Formatter().parse(a))
+        except ValueError as exc:
+            raise ConfigError("command line", "--fsw-cmd", template,
+                              f"placeholders among {allowed} ({exc}; write {{{{ for a brace)"
+                              ) from exc
+        for literal, name, spec, conv in parsed:
+            parts.append(literal)
+            if name is None:
+                continue
+            if name not in values or spec or conv:
+                raise ConfigError("command line", "--fsw-cmd", template,
+                                  f"placeholders among {allowed}, as plain names (found "
+                                  f"{{{name}{'!' + conv if conv else ''}"
+                                  f"{':' + spec if spec else ''}}})")
+            parts.append(values[name])
+        out.append("".join(parts))
+    return out
 
 
 class Terminated(Exception):  # noqa: N818 - a request, not an error
@@ -268,8 +293,11 @@ def _run_bench(
         summary["deadline_misses"]["total"] = sum(
             v for k, v in summary["deadline_misses"].items() if k in ("bench_late", "fsw_overruns")
         )
-    summary["warnings"] = (bus_warnings(summary["frames"]) + duration_warnings(sc, opts.duration_s)
-                           + scenario_warnings(sc))
+    summary["compromised"] = compromised(summary)
+    summary["warnings"] = (bus_warnings(summary) + duration_warnings(sc, opts.duration_s)
+                           + scenario_warnings(sc)
+                           + [f"flight software: {w}" for w in summary["fsw"].get("warnings", [])
+                              if isinstance(w, str)])
     if error is None and not (summary.get("valve_openings") or {}).get("total"):
         summary["warnings"].append(
             "no valve opened in the whole run: if the vehicle was to move, check the thrust "
@@ -287,20 +315,14 @@ def _run_bench(
             getattr(bus, "overrun_drops_by_pid", {}), fsw_by_pid, os.getpid(),
             None if proc is None else proc.pid,
             float(getattr(bus, "member_stall_s", None) or MEMBER_STALL_S)))
-    if any("another node" in w for w in summary["warnings"]):
+    if summary["compromised"] is not None:
         summary["passed"] = False
     if error is not None:
         summary["error"] = f"{type(error).__name__}: {error}"
         if "first frame" in str(error):
             summary["fsw"]["log_tail"] = _log_tail(out / "fsw.log")
-            # ours writes its reason to the statistics file; another flight software's last
-            # "error:" line in its log is taken for it
-            refusal = [x.split(FSW_ERROR_MARK, 1)[1].strip()
-                       for x in summary["fsw"]["log_tail"] if FSW_ERROR_MARK in x]
-            if summary["fsw"].get("refused"):
-                refusal.append(summary["fsw"]["refused"])
-            if fsw_rc == FSW_EXIT_BAD_INPUT and refusal:
-                summary["fsw"]["refused"] = refusal[-1]
+            # a refusal is a record in the statistics file (dbc.contract.FswRefusal)
+            if fsw_rc == EXIT_REFUSED and summary["fsw"].get("refused"):
                 summary["error"] = f"the flight software refused its configuration: " \
                                    f"{summary['fsw']['refused']}"
                 error = RefusedConfigError("the flight software", summary["fsw"]["refused"])
@@ -405,16 +427,46 @@ def duration_warnings(sc: Scenario, duration_s: float) -> list[str]:
     return out
 
 
-def bus_warnings(frames: dict[str, dict[str, Any]]) -> list[str]:
-    """Signs that something else shares the bus: own messages from another node, stale frames."""
+def compromised(summary: dict[str, Any]) -> dict[str, Any] | None:
+    """Evidence that a second sender spoke the ICD on this bus, or None.
+
+    Each side's evidence (its own messages heard well-formed from another node, alive
+    counters gone back, a second different command for one cycle), by message; ``messages``
+    names them all. A run with any is compromised: its results may hold another node's
+    frames, so it does not pass.
+    """
+    bench = dict(summary.get("second_sender_evidence") or {})
+    fsw = dict((summary.get("fsw") or {}).get("second_sender_evidence") or {})
+    names = sorted(set(bench) | set(fsw))
+    if not names:
+        return None
+    return {"messages": names, "evidence": {"BENCH": bench, "FSW": fsw}}
+
+
+def bus_warnings(summary: dict[str, Any]) -> list[str]:
+    """Signs that something else shares the bus: a second sender, stale frames, refused
+    restarts."""
     out = []
-    for name, f in frames.items():
+    comp = summary.get("compromised")
+    if comp is not None:
+        ev = comp["evidence"]
+        counts = ", ".join(f"{n} ({ev['BENCH'].get(n, 0) + ev['FSW'].get(n, 0)})"
+                           for n in comp["messages"])
+        out.append(f"run compromised: another node sends frames of the ICD on this bus: "
+                   f"{counts}. A second bench or flight software, or forged frames? "
+                   "Use a bus of your own (--bus).")
+    for name, f in summary["frames"].items():
         rej = f.get("rejected") or {}
-        if rej.get("unexpected"):
-            out.append(f"another node sends {name} on this bus ({rej['unexpected']} frames): "
-                       "a second bench or flight software? Use a bus of your own (--bus).")
         if rej.get("stale"):
-            out.append(f"{rej['stale']} stale {name} frames (for another cycle)")
+            out.append(f"{rej['stale']} stale {name} frames (for another cycle, or older "
+                       "than the last one taken)")
+    refused = int((summary.get("fsw") or {}).get("restarts_refused") or 0)
+    if refused:
+        out.append(f"the flight software refused {refused} bench restarts (SYNC or "
+                   "BENCH_STATUS going back while the bench was live: replayed frames?)")
+    if summary.get("fsw_restarts_refused"):
+        out.append(f"the bench refused {summary['fsw_restarts_refused']} flight-software "
+                   "restarts (FSW_STATUS in BOOT mode while it was live: replayed frames?)")
     return out
 
 
@@ -425,11 +477,20 @@ def _log_tail(log: Path, lines: int = 5) -> list[str]:
 
 
 def _fsw_report(stats: Path, rc: int | None, out: Path) -> dict[str, Any]:
+    """The flight software's part of summary.json: its exit code, its statistics or its
+    refusal (dbc.contract records), and its log's tail when it failed."""
     rep: dict[str, Any] = {"exit_code": rc}
     if stats.exists():
         try:
-            rep.update(json.loads(stats.read_text(encoding="utf-8")))
-        except (OSError, json.JSONDecodeError) as exc:
+            data = json.loads(stats.read_text(encoding="utf-8"))
+            if isinstance(data, dict) and data.get("schema") == REFUSAL_SCHEMA:
+                refusal = FswRefusal.from_json(data, str(stats))
+                rep.update(refused=refusal.message, refusal=refusal.to_json())
+            elif isinstance(data, dict):
+                rep.update(data)
+            else:
+                rep["stats_error"] = f"{stats}: not a JSON object"
+        except (OSError, json.JSONDecodeError, ConfigError) as exc:
             rep["stats_error"] = str(exc)
     else:
         rep["stats_error"] = "flight software wrote no statistics"

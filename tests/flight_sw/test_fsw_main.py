@@ -6,21 +6,26 @@ import json
 from pathlib import Path
 
 from bench.scenario.load import load_scenario
-from flight_sw.__main__ import EXIT_BAD_INPUT, main
+from dbc.contract import EXIT_REFUSED, REFUSAL_SCHEMA, FswRefusal
+from flight_sw.__main__ import main
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 
 
 def test_refused_configuration_exits_2_with_the_reason_in_the_stats_file(tmp_path: Path) -> None:
-    """A bad modulator kind: exit 2, stderr and the --stats file both name key and value."""
+    """A bad modulator kind: exit 2; the --stats file holds a refusal record naming the key
+    and the value."""
     cfg = load_scenario(QUICKSTART).fsw_config()
     cfg["flight_sw"]["modulator"]["kind"] = "pwfp"
     config = tmp_path / "fsw_config.json"
     config.write_text(json.dumps(cfg), encoding="utf-8")
     stats = tmp_path / "fsw_stats.json"
-    assert main(["--config", str(config), "--stats", str(stats)]) == EXIT_BAD_INPUT
-    refused = json.loads(stats.read_text(encoding="utf-8"))["refused"]
-    assert "modulator.kind" in refused and "'pwfp'" in refused
+    assert main(["--config", str(config), "--stats", str(stats)]) == EXIT_REFUSED
+    data = json.loads(stats.read_text(encoding="utf-8"))
+    assert data["schema"] == REFUSAL_SCHEMA
+    refusal = FswRefusal.from_json(data, str(stats))
+    assert refusal.key == "flight_sw.modulator.kind" and refusal.value == "pwfp"
+    assert "'pwfp'" in refusal.message
 
 
 def test_good_configuration_checks_ok_and_writes_no_refusal(tmp_path: Path) -> None:

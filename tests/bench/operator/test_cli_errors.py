@@ -51,7 +51,19 @@ def test_bad_fsw_cmd_placeholder_exits_2_before_any_process(
     """--fsw-cmd with an unknown {placeholder}: exit 2 naming it; no run folder."""
     code, err = _run(["--bus", f"hilbus:cli{uuid.uuid4().hex[:8]}", "--out",
                       str(tmp_path / "run"), "--fsw-cmd", "fsw --config {foo}"], capsys)
-    assert code == EXIT_BAD_INPUT and "--fsw-cmd" in err and "'foo'" in err, err
+    assert code == EXIT_BAD_INPUT and "--fsw-cmd" in err and "{foo}" in err, err
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("template", ["fsw {config.__class__}", "fsw {config[0]}",
+                                      "fsw {config!r}", "fsw {config:>9}", "fsw {config"])
+def test_fsw_cmd_placeholders_are_plain_names(
+    template: str, tmp_path: Path, runtime: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Attribute or index access, conversions, format specs, an unclosed brace: exit 2."""
+    code, err = _run(["--bus", f"hilbus:cli{uuid.uuid4().hex[:8]}", "--out",
+                      str(tmp_path / "run"), "--fsw-cmd", template], capsys)
+    assert code == EXIT_BAD_INPUT and "--fsw-cmd" in err and "placeholders" in err, err
     assert not (tmp_path / "run").exists()
 
 
