@@ -95,6 +95,8 @@ class Icd:
     failure_kinds: Mapping[int, str]  # FSW_FDIR.FailureKind value -> name
     no_failed_thruster: int  # FSW_FDIR.FailedThruster when none is isolated
     health_flags: Mapping[str, int]  # BENCH_STATUS.Health name -> bit
+    fdir_flags: Mapping[str, int]  # FSW_STATUS.FdirFlags name -> bit
+    sensor_flags: Mapping[str, int]  # FSW_FDIR.SensorFlags name -> bit
     fault_cmd_counter_none: int  # BENCH_STATUS.FaultCmdCounter before any FAULT_CMD
 
     @classmethod
@@ -172,6 +174,9 @@ class Icd:
             health_flags=_flags(_value_table(msgs["BENCH_STATUS"], "Health"),
                                 "BENCH_STATUS.Health"),
             fault_cmd_counter_none=counter_none[0],
+            fdir_flags=_flags(_value_table(msgs["FSW_STATUS"], "FdirFlags"),
+                              "FSW_STATUS.FdirFlags"),
+            sensor_flags=_flags(_value_table(fdir, "SensorFlags"), "FSW_FDIR.SensorFlags"),
         )
 
     @property

@@ -29,9 +29,10 @@ from typing import Any
 
 from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError, RunError
+from dbc.faults import STUCK_CLOSED, STUCK_OPEN
 from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
-KINDS = ("stuck_closed", "stuck_open")
+KINDS = (STUCK_CLOSED, STUCK_OPEN)
 DEFAULT_FAULT_TIME_S = 10.0
 EXIT_BAD_INPUT, EXIT_RUN_ERROR = 2, 3  # as thruster-hil run's
 COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruster",

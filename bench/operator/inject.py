@@ -25,7 +25,6 @@ from transport.spec import open_bus
 INJECT_SOURCE = "thruster-hil inject"
 DEFAULT_TIMEOUT_S = 5.0
 ICD = Icd.from_database(load_database())
-COUNTER_NONE = ICD.fault_cmd_counter_none
 KIND_CODES = {kind: code for code, kind in ICD.fault_kinds.items()}
 
 
@@ -76,7 +75,7 @@ def inject(bus_spec: str, cmd: FaultCommand, timeout_s: float = DEFAULT_TIMEOUT_
     checker = FrameChecker(db, accept=frozenset({"BENCH_STATUS"}))
     with open_bus(bus_spec) as bus:
         last, _ = _bench_status(bus, checker, timeout_s)
-        counter = 0 if last == COUNTER_NONE else (last + 1) % e2e.COUNTER_MODULUS
+        counter = 0 if last == ICD.fault_cmd_counter_none else (last + 1) % e2e.COUNTER_MODULUS
         frame = db.get_message_by_name("FAULT_CMD")
         bus.send(can.Message(arbitration_id=frame.frame_id, is_extended_id=False,
                              data=Encoder(db).encode("FAULT_CMD", cmd.signals(), counter=counter)))

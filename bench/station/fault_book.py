@@ -26,6 +26,7 @@ from typing import Any
 
 from bench.station.faults import BUS_KINDS, REALTIME_BUS_KINDS, FaultSpec, fault_from_command
 from bench.station.plant import Plant
+from dbc.faults import BUS_OFF
 from dbc.icd import Icd
 
 NS_PER_S = 1_000_000_000
@@ -103,7 +104,7 @@ class FaultBook:
             self._plant.thrusters.set_fault(f.thruster, f.kind, t_ns, **f.params)
         elif f.sensor is not None:
             self._sensor(f.sensor).set_fault(f.kind, t_ns, **f.params)
-        elif f.kind == "bus_off" and f.node is not None:
+        elif f.kind == BUS_OFF and f.node is not None:
             until = end_ns if end_ns is not None else t_ns + self._recovery_ns
             self.bus_off_windows.append((f.node, t_ns, until))
             rec["until_s"] = until / NS_PER_S

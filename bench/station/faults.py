@@ -41,28 +41,43 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from dbc.errors import ConfigError
+from dbc.faults import (
+    BABBLING,
+    BIAS_JUMP,
+    BUS_KINDS,
+    BUS_OFF,
+    DEGRADED,
+    DELAY,
+    DELAYED,
+    FAULT_KINDS,
+    FRAME_KINDS,
+    INTERMITTENT,
+    LEAK,
+    MISALIGNED,
+    NOISE,
+    REALTIME_BUS_KINDS,
+    SENSOR_KINDS,
+    THRUSTER_KINDS,
+)
 from dbc.icd import Icd
 from dbc.schema import Table
 
-THRUSTER_KINDS = ("stuck_closed", "stuck_open", "degraded", "delayed", "intermittent", "leak",
-                  "misaligned")
+__all__ = ["BUS_KINDS", "FAULT_KINDS", "FRAME_KINDS", "REALTIME_BUS_KINDS", "SENSOR_KINDS",
+           "THRUSTER_KINDS", "FaultSpec", "fault_from_command", "parse_faults"]
+
 THRUSTER_PARAMS: dict[str, tuple[tuple[str, float, float], ...]] = {  # (name, lo, hi)
-    "degraded": (("factor", 0.0, 1.0),),
-    "delayed": (("extra_delay_s", 0.0, 1.0),),
-    "intermittent": (("dropout_probability", 0.0, 1.0),),
-    "leak": (("thrust_N", 0.0, 1e3),),
-    "misaligned": (("angle_deg", -180.0, 180.0),),
+    DEGRADED: (("factor", 0.0, 1.0),),
+    DELAYED: (("extra_delay_s", 0.0, 1.0),),
+    INTERMITTENT: (("dropout_probability", 0.0, 1.0),),
+    LEAK: (("thrust_N", 0.0, 1e3),),
+    MISALIGNED: (("angle_deg", -180.0, 180.0),),
 }
-SENSORS = ("gyro", "accelerometer", "star_tracker")
-SENSOR_KINDS = ("bias_jump", "frozen", "outage", "noise")
+SENSORS = ("gyro", "accelerometer", "star_tracker")  # FAULT_CMD.Target of sensor faults
 BIAS_JUMP_PARAM = {"gyro": "jump_rad_s", "accelerometer": "jump_m_s2",
                    "star_tracker": "misalignment_arcsec"}
-FRAME_KINDS = ("link_error", "drop", "delay", "corrupt", "duplicate")
-BUS_KINDS = (*FRAME_KINDS, "bus_off", "babbling")
-REALTIME_BUS_KINDS = frozenset({"drop", "corrupt", "duplicate"})  # need no modelled bus
 MAX_STD_ID = 0x7FF
 MAX_RATE_HZ = 20_000.0  # above a 1 Mbit/s bus's capacity for 8-byte frames
-FAULT_KINDS = THRUSTER_KINDS + BUS_KINDS + SENSOR_KINDS
+BABBLER = "BABBLER"  # the node name of a babbling fault's frames
 
 
 @dataclass(frozen=True)
@@ -103,15 +118,15 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
             params: dict[str, Any] = {
                 name: f.number(name, lo=lo, hi=hi) for name, lo, hi in THRUSTER_PARAMS.get(kind, ())
             }
-            if kind == "misaligned":
+            if kind == MISALIGNED:
                 params["axis_B"] = f.vector3("axis_B")
             spec = FaultSpec(t_s, kind, dur, thruster=k, params=params)
         elif kind in SENSOR_KINDS:
             sensor = f.string("sensor", choices=SENSORS)
             params = {}
-            if kind == "bias_jump":
+            if kind == BIAS_JUMP:
                 params[BIAS_JUMP_PARAM[sensor]] = f.vector3(BIAS_JUMP_PARAM[sensor])
-            elif kind == "noise":
+            elif kind == NOISE:
                 params["factor"] = f.number("factor", lo=0.0)
             spec = FaultSpec(t_s, kind, dur, sensor=sensor, params=params)
         elif kind in FRAME_KINDS:
@@ -121,10 +136,10 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
             if (message is None) == (node is None):
                 raise f.error("message", None, "exactly one of message = NAME or node = NAME")
             params = {"probability": f.number("probability", 1.0, lo=0.0, lo_open=True, hi=1.0)}
-            if kind == "delay":
+            if kind == DELAY:
                 params["delay_s"] = f.number("delay_s", lo=0.0, lo_open=True, hi=1.0)
             spec = FaultSpec(t_s, kind, dur, message=message, node=node, params=params)
-        elif kind == "babbling":
+        elif kind == BABBLING:
             can_id = f.integer("can_id", lo=0)
             if can_id > MAX_STD_ID:
                 raise f.error("can_id", can_id, f"an 11-bit ID 0..{MAX_STD_ID}")
@@ -139,11 +154,10 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
 
 
 # the single Param of a FAULT_CMD, per kind that takes one
-FAULT_CMD_PARAM = {"degraded": "factor", "misaligned": "angle_deg", "delayed": "extra_delay_s",
-                   "intermittent": "dropout_probability", "leak": "thrust_N", "noise": "factor"}
+FAULT_CMD_PARAM = {DEGRADED: "factor", MISALIGNED: "angle_deg", DELAYED: "extra_delay_s",
+                   INTERMITTENT: "dropout_probability", LEAK: "thrust_N", NOISE: "factor"}
 FAULT_CMD_AXIS_B = (0.0, 0.0, 1.0)  # misalignment axis of a FAULT_CMD (not encodable)
 FAULT_CMD_SOURCE = "FAULT_CMD"  # where a refused live command's bad value came from
-BABBLER = "BABBLER"  # the node name of a babbling fault's frames
 KHZ = 1000.0
 
 
@@ -173,7 +187,7 @@ def fault_from_command(signals: dict[str, float], icd: Icd, n_thrusters: int,
         params: dict[str, Any] = {}
         if kind in FAULT_CMD_PARAM:
             params[FAULT_CMD_PARAM[kind]] = param
-        if kind == "misaligned":
+        if kind == MISALIGNED:
             params["axis_B"] = FAULT_CMD_AXIS_B
         return FaultSpec(t_s, kind, dur, thruster=target, params=params)
     if kind in SENSOR_KINDS:
@@ -182,17 +196,17 @@ def fault_from_command(signals: dict[str, float], icd: Icd, n_thrusters: int,
                               f"a sensor index 0..{len(SENSORS) - 1} ({', '.join(SENSORS)})")
         sensor = SENSORS[target]
         params = {}
-        if kind == "noise":
+        if kind == NOISE:
             params["factor"] = param
-        elif kind == "bias_jump":  # Param on the sensor's x axis, in its units
+        elif kind == BIAS_JUMP:  # Param on the sensor's x axis, in its units
             params[BIAS_JUMP_PARAM[sensor]] = (param, 0.0, 0.0)
         return FaultSpec(t_s, kind, dur, sensor=sensor, params=params)
-    if kind == "bus_off":
+    if kind == BUS_OFF:
         if target >= len(icd.nodes):
             raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
                               f"a node index 0..{len(icd.nodes) - 1} ({', '.join(icd.nodes)})")
         return FaultSpec(t_s, kind, dur, node=icd.nodes[target])
-    if kind == "babbling":
+    if kind == BABBLING:
         if target > MAX_STD_ID:
             raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
                               f"an 11-bit CAN ID 0..0x{MAX_STD_ID:X} to babble with")
@@ -204,7 +218,7 @@ def fault_from_command(signals: dict[str, float], icd: Icd, n_thrusters: int,
     if message is None:
         raise ConfigError(FAULT_CMD_SOURCE, "Target", target,
                           f"the CAN ID of a DBC message for {kind}")
-    if kind == "delay":
+    if kind == DELAY:
         if not param > 0:
             raise ConfigError(FAULT_CMD_SOURCE, "Param", param, "a delay > 0 s")
         return FaultSpec(t_s, kind, dur, message=message,

@@ -19,7 +19,8 @@ from typing import Any
 
 import can
 
-from bench.station.faults import FRAME_KINDS, FaultSpec
+from bench.station.faults import FaultSpec
+from dbc.faults import CORRUPT, DELAY, DROP, DUPLICATE, FRAME_KINDS
 
 NS_PER_S = 1e9
 
@@ -53,13 +54,13 @@ def frame_fate(active: list[FaultSpec], name: str, sender: str, rng: Any) -> Fat
             continue
         if rng.random() >= f.params["probability"]:
             continue
-        if f.kind == "drop":
+        if f.kind == DROP:
             drop = True
-        elif f.kind == "delay":
+        elif f.kind == DELAY:
             delay += round(f.params["delay_s"] * NS_PER_S)
-        elif f.kind == "corrupt":
+        elif f.kind == CORRUPT:
             bit = int(rng.integers(PAYLOAD_BITS))
-        elif f.kind == "duplicate":
+        elif f.kind == DUPLICATE:
             dup = True
         else:
             fails += 1

@@ -33,6 +33,7 @@ from bench.wire.fate import NO_FATE, Fate, flip, frame_fate
 from bench.wire.timing import INTERMISSION_BITS, BusArbiter, Delivery, frame_bits, wire_time_ns
 from bench.wire.trace import NAN, TraceRecorder
 from dbc.codec import Encoder
+from dbc.faults import BABBLING
 from dbc.icd import BENCH, Icd
 from transport.lockstep import send_frames
 
@@ -124,7 +125,7 @@ class Wire:
     def babble(self, t0_ns: int, t1_ns: int) -> None:
         """Frames of the active babbling nodes for [t0, t1): on the bus and on the model."""
         for f in self.active_faults():
-            if f.kind != "babbling":
+            if f.kind != BABBLING:
                 continue
             step = round(NS_PER_S / f.params["rate_hz"])
             t = -(-t0_ns // step) * step

@@ -56,3 +56,24 @@ def test_a_dbc_without_a_needed_value_table_is_refused_naming_it() -> None:
     db = cantools.database.load_string("\n".join(lines), database_format="dbc")
     with pytest.raises(IcdError, match=r"FSW_STATUS\.Mode"):
         Icd.from_database(db)
+
+
+def test_the_flight_softwares_modes_and_flags_are_the_dbcs() -> None:
+    """flight_sw.modes' Mode, FdirFlag and SensorFlag equal the DBC's value tables."""
+    from flight_sw.modes import FdirFlag, Mode, SensorFlag
+
+    icd = Icd.from_database(DB)
+    assert {m.name: int(m) for m in Mode} == dict(icd.modes)
+    assert {f.name.lower(): int(f) for f in FdirFlag} == dict(icd.fdir_flags)
+    assert {f.name.lower(): int(f) for f in SensorFlag} == dict(icd.sensor_flags)
+
+
+def test_fault_kinds_are_the_dbcs_fault_types() -> None:
+    """dbc.faults names exactly the DBC's FAULT_CMD.FaultType kinds, grouped without overlap."""
+    from dbc import faults
+
+    icd = Icd.from_database(DB)
+    assert sorted(faults.FAULT_KINDS) == sorted(icd.fault_kinds.values())
+    groups = (faults.THRUSTER_KINDS, faults.SENSOR_KINDS, faults.BUS_KINDS)
+    assert sum(len(g) for g in groups) == len(set().union(*groups))
+    assert set(faults.FRAME_KINDS) >= faults.REALTIME_BUS_KINDS

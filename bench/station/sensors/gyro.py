@@ -62,6 +62,7 @@ from mypy_extensions import mypyc_attr
 
 from bench.station.dynamics.rigid_body import Vec3
 from dbc.errors import ConfigError, ThrusterHilError
+from dbc.faults import BIAS_JUMP, FROZEN, NOISE, OUTAGE
 
 S_PER_NS = 1e-9
 DEFAULT_PERIOD_S = 0.005
@@ -71,10 +72,10 @@ NORMALS_PER_SAMPLE = 6
 AXES = 3
 ZERO_VEC3: Vec3 = (0.0, 0.0, 0.0)
 """The output reported by an outage before any valid sample."""
-FAULT_BIAS_JUMP = "bias_jump"
-FAULT_FROZEN = "frozen"
-FAULT_OUTAGE = "outage"
-FAULT_NOISE = "noise"
+FAULT_BIAS_JUMP = BIAS_JUMP
+FAULT_FROZEN = FROZEN
+FAULT_OUTAGE = OUTAGE
+FAULT_NOISE = NOISE
 INERTIAL_FAULT_KINDS = frozenset({FAULT_BIAS_JUMP, FAULT_FROZEN, FAULT_OUTAGE, FAULT_NOISE})
 SensorFaultParams = dict[str, float | tuple[float, ...]]
 """Recorded parameters of one active sensor fault: name → number or vector (a copy)."""

@@ -65,6 +65,7 @@ from bench.station.dynamics.rigid_body import Vec3, Wrench, quat_from_axis_angle
 from bench.station.valves.base import ValveModel
 from bench.station.valves.valve import FAULT_KINDS, S_PER_NS, FaultParams, Valve, ValveParams
 from dbc.errors import ConfigError
+from dbc.faults import MISALIGNED
 
 G0_M_S2 = 9.80665
 """Standard gravity [m/s²], used to convert impulse to propellant mass through Isp."""
@@ -73,7 +74,7 @@ UNIT_NORM_TOL = 1e-6
 VEC3_LEN = 3
 SIMPSON_MID_WEIGHT = 4.0
 SIMPSON_DIVISOR = 6.0
-FAULT_MISALIGNED = "misaligned"
+FAULT_MISALIGNED = MISALIGNED
 THRUSTER_FAULT_KINDS = FAULT_KINDS | {FAULT_MISALIGNED}
 """Every fault kind ``ThrusterSet.set_fault`` accepts."""
 MISALIGNED_PARAMS = ("angle_deg", "axis_B")

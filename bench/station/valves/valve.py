@@ -101,6 +101,7 @@ import numpy as np
 from mypy_extensions import mypyc_attr
 
 from dbc.errors import ConfigError
+from dbc.faults import DEGRADED, DELAYED, INTERMITTENT, LEAK, STUCK_CLOSED, STUCK_OPEN
 
 NS_PER_S = 1_000_000_000
 S_PER_NS = 1e-9
@@ -113,12 +114,12 @@ HISTORY_NS = 10_000_000
 step may be sampled from its start after several events inside it (commands, faults)."""
 NEVER_NS = 2**63 - 1
 """A time later than any simulation (idle_from_ns of a valve that never stops)."""
-FAULT_STUCK_CLOSED = "stuck_closed"
-FAULT_STUCK_OPEN = "stuck_open"
-FAULT_DEGRADED = "degraded"
-FAULT_DELAYED = "delayed"
-FAULT_INTERMITTENT = "intermittent"
-FAULT_LEAK = "leak"
+FAULT_STUCK_CLOSED = STUCK_CLOSED
+FAULT_STUCK_OPEN = STUCK_OPEN
+FAULT_DEGRADED = DEGRADED
+FAULT_DELAYED = DELAYED
+FAULT_INTERMITTENT = INTERMITTENT
+FAULT_LEAK = LEAK
 FAULT_PARAMS: Mapping[str, tuple[str, ...]] = {
     FAULT_STUCK_CLOSED: (),
     FAULT_STUCK_OPEN: (),
