@@ -12,7 +12,7 @@ Times: ``t_rx`` is the interface's receive timestamp (``msg.timestamp``: the ker
 SocketCAN, the receiver's :func:`time.time` on hilbus) minus the first frame's; ``t_ready``
 is the sender's transmission time where the interface carries it (hilbus's
 ``tx_timestamp``, same host and clock), so latency is measured there, ``nan`` elsewhere.
-Bus load: each frame's exact stuffed length (:func:`bench.wire.timing.frame_bits`) at the
+Bus load: each frame's exact stuffed length (:func:`bench.wire.timing.classic.frame_bits`) at the
 DBC's ``Baudrate`` (or a given bitrate), ending at its receive time: an estimate, since a
 listener does not see the wire itself (error frames are counted, not timed).
 
@@ -33,7 +33,7 @@ import can
 
 from bench.operator.analysis.defaults import DEFAULT_FIRST_FRAME_TIMEOUT_S
 from bench.operator.analysis.timing import FrameTable, RunTiming, TimingOptions, dbc_bitrate_bps
-from bench.wire.timing import frame_bits
+from bench.wire.timing.classic import frame_bits
 from dbc.database import load_database
 from dbc.e2e import COUNTER_BYTE, COUNTER_MASK
 from dbc.errors import ConfigError, RunError

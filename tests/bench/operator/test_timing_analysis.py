@@ -25,6 +25,8 @@ from bench.operator.analysis.timing import (
     window_busy_s,
 )
 from bench.results.writers import CHAIN_COLUMNS
+from bench.wire.timing.arbiter import Delivery
+from bench.wire.timing.load import busy_ns_per_window
 from bench.wire.trace import FRAME_COLUMNS
 from dbc.database import load_database
 from dbc.errors import ConfigError, RunError
@@ -216,20 +218,18 @@ def test_window_busy_splits_intervals_exactly() -> None:
 
 
 def test_window_busy_agrees_with_bus_model_load() -> None:
-    """Same busy time per window as bench.wire.timing.busy_ns_per_window (independent code)."""
-    bt = pytest.importorskip("bench.wire.timing")
-    if not hasattr(bt, "busy_ns_per_window"):
-        pytest.skip("bench.wire.timing has no busy_ns_per_window yet")
+    """Same busy time per window as bench.wire.timing.load.busy_ns_per_window (independent
+    code)."""
     rng = np.random.default_rng(7)
     window_ns, n_windows = 10_000_000, 50
     starts = np.sort(rng.integers(0, (n_windows - 1) * window_ns, 400))
     ends = starts + rng.integers(50_000, 3 * window_ns, starts.size)
     dels = [
-        bt.Delivery(0, int(a), int(b), 1, i)
+        Delivery(0, int(a), int(b), 1, i)
         for i, (a, b) in enumerate(zip(starts, ends, strict=True))
     ]
     t1 = n_windows * window_ns + 3 * window_ns
-    ref = [busy for _, busy in bt.busy_ns_per_window(dels, window_ns, 0, t1)]
+    ref = [busy for _, busy in busy_ns_per_window(dels, window_ns, 0, t1)]
     mine = window_busy_s(starts / 1e9, ends / 1e9, 0.0, window_ns / 1e9, len(ref))
     assert mine * 1e9 == pytest.approx(ref, abs=1.0)  # 1 ns: float seconds vs integer ns
 
