@@ -46,7 +46,8 @@ from bench.station.fault_book import Event
 from bench.station.plant import STEP_NS
 from bench.station.station import Pulse, Station
 from bench.wire.receipt import Arrival, Receipt
-from bench.wire.timing import bus_off_recovery_ns, frame_bits
+from bench.wire.timing.arbiter import bus_off_recovery_ns
+from bench.wire.timing.classic import frame_bits
 from bench.wire.trace import TraceRecorder
 from bench.wire.wire import Wire
 from dbc.codec import Decoded, Encoder, FrameChecker

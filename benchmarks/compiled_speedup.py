@@ -52,7 +52,7 @@ def _kernels() -> dict[str, tuple[Callable[[], object], Callable[[], object]]]:
     mp = rb_c.MassProperties(87.0, ((15.95, 0.0, 0.0), (0.0, 72.19, 0.0), (0.0, 0.0, 72.19)))
     state = (1.0, 0.0, 0.0, 0.0, 0.01, -0.02, 0.03, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     w = (1.0, 2.0, 3.0, 0.1, 0.2, 0.3)
-    tm_c, tm_s = _twins("bench.wire.timing")
+    tm_c, tm_s = _twins("bench.wire.timing.classic")
     e2e_c, e2e_s = _twins("dbc.e2e")
     data = bytes(range(8))
     dq_c, dq_s = _twins("flight_sw.dual_quaternion")

@@ -30,8 +30,8 @@ from bench.station.dynamics.rigid_body import (
     quat_normalize,
     rk4_step,
 )
+from bench.station.valves.params import ValveParams
 from bench.station.valves.thruster_set import ThrusterGeometry, ThrusterSet
-from bench.station.valves.valve import ValveParams
 
 DT_NS = 1_000_000
 DT_S = DT_NS * 1e-9

@@ -92,8 +92,8 @@ def test_rk4_step_matches_source() -> None:
 
 def test_frame_bits_and_crc_match_source() -> None:
     """Stuffed CAN frame lengths and E2E CRCs equal the interpreted ones on random frames."""
-    timing = importlib.import_module("bench.wire.timing")
-    timing_src = _source_twin("bench.wire.timing")
+    timing = importlib.import_module("bench.wire.timing.classic")
+    timing_src = _source_twin("bench.wire.timing.classic")
     e2e = importlib.import_module("dbc.e2e")
     e2e_src = _source_twin("dbc.e2e")
     rng = np.random.default_rng(SEED)

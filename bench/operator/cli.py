@@ -146,8 +146,9 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 def _cmd_timing(args: argparse.Namespace) -> int:
     from bench.operator.analysis.live import LiveOptions, live_timing
+    from bench.operator.analysis.records import TimingOptions
     from bench.operator.analysis.report import format_report, write_histograms, write_json
-    from bench.operator.analysis.timing import RunTiming, TimingOptions
+    from bench.operator.analysis.timing import RunTiming
 
     if args.live == (args.run_dir is not None):
         raise ConfigError("timing", "RUN_DIR/--live", args.run_dir, "a run folder or --live")

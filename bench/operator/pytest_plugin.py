@@ -53,14 +53,14 @@ from typing import TYPE_CHECKING, Any
 import pytest
 
 if TYPE_CHECKING:
-    from bench.operator.analysis.timing import (
+    from bench.operator.analysis.records import (
         BusLoad,
         ChainTiming,
         MessageTiming,
         Percentiles,
-        RunTiming,
         TimingOptions,
     )
+    from bench.operator.analysis.timing import RunTiming
 
 MODES = ("lockstep", "realtime")
 DEFAULT_MODE = "lockstep"
@@ -307,7 +307,7 @@ class HilRunner:
         override the scenario's; ``fsw_cmd``: the flight-software command (None: the
         bench alone; default ``--hil-fsw-cmd`` or this project's flight software);
         ``overrides``: scenario ``KEY=VALUE`` overrides (``"bus.bitrate_bps=125000"``);
-        ``timing``: :class:`~bench.operator.analysis.timing.TimingOptions` for the measurements;
+        ``timing``: :class:`~bench.operator.analysis.records.TimingOptions` for the measurements;
         ``fresh``: do not reuse an identical lockstep run of this session.
         """
         from bench.operator.orchestrator import DEFAULT_FSW_CMD

@@ -37,9 +37,9 @@ from bench.station.sensors.gyro import Gyro, GyroParams
 from bench.station.sensors.rel_nav import RelNav, RelNavParams
 from bench.station.sensors.star_tracker import StarTracker, StarTrackerParams
 from bench.station.valves.base import ValveModel
+from bench.station.valves.params import ValveParams
 from bench.station.valves.throttled import ThrottledValve
 from bench.station.valves.thruster_set import ThrusterGeometry, ThrusterSet
-from bench.station.valves.valve import ValveParams
 
 STEP_NS = 1_000_000
 NS_PER_S = 1e9

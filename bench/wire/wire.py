@@ -30,7 +30,8 @@ import numpy as np
 
 from bench.station.faults import FaultSpec
 from bench.wire.fate import NO_FATE, Fate, flip, frame_fate
-from bench.wire.timing import INTERMISSION_BITS, BusArbiter, Delivery, frame_bits, wire_time_ns
+from bench.wire.timing.arbiter import BusArbiter, Delivery
+from bench.wire.timing.classic import INTERMISSION_BITS, frame_bits, wire_time_ns
 from bench.wire.trace import NAN, TraceRecorder
 from dbc.codec import Encoder
 from dbc.faults import BABBLING

@@ -25,6 +25,10 @@ EXPECTED_PLOTS = 3
 
 
 def _load() -> ModuleType:
+    # as ``python benchmarks/robust_allocation.py`` does: its directory on sys.path, for the
+    # module beside it (seed001_allocation)
+    if str(SCRIPT.parent) not in sys.path:
+        sys.path.insert(0, str(SCRIPT.parent))
     spec = importlib.util.spec_from_file_location(MODULE_NAME, SCRIPT)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)

@@ -9,7 +9,8 @@ from pathlib import Path
 import can
 import pytest
 
-from bench.wire.timing import failed_attempt_bits, wire_time_ns
+from bench.wire.timing.arbiter import failed_attempt_bits
+from bench.wire.timing.classic import wire_time_ns
 from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
 

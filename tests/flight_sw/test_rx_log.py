@@ -7,7 +7,7 @@ from pathlib import Path
 import can
 
 from bench.operator.analysis.reception import RX_LOG_COLUMNS, receive_log
-from bench.operator.analysis.timing import read_csv_columns
+from bench.operator.analysis.tables import read_csv_columns
 from flight_sw.rx_log import NO_COUNTER, ReceiveLog
 from flight_sw.rx_log import RX_LOG_COLUMNS as FSW_COLUMNS
 

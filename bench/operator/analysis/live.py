@@ -3,7 +3,7 @@
 What: opens any python-can bus (``socketcan:vcan0``, ``hilbus:<channel>``,
 ``pcan:PCAN_USBBUS1?bitrate=1000000`` ...), waits for the first frame, records every
 frame for ``duration_s`` seconds and turns the capture into a
-:class:`~bench.operator.analysis.timing.FrameTable`, so
+:class:`~bench.operator.analysis.tables.FrameTable`, so
 :class:`~bench.operator.analysis.timing.RunTiming`
 measures per-ID count, period mean and jitter, missed cycles, cycle-time violations
 against the DBC and bus load exactly as for a run folder (mode ``live``).
@@ -12,13 +12,13 @@ Times: ``t_rx`` is the interface's receive timestamp (``msg.timestamp``: the ker
 SocketCAN, the receiver's :func:`time.time` on hilbus) minus the first frame's; ``t_ready``
 is the sender's transmission time where the interface carries it (hilbus's
 ``tx_timestamp``, same host and clock), so latency is measured there, ``nan`` elsewhere.
-Bus load: each frame's exact stuffed length (:func:`bench.wire.timing.frame_bits`) at the
+Bus load: each frame's exact stuffed length (:func:`bench.wire.timing.classic.frame_bits`) at the
 DBC's ``Baudrate`` (or a given bitrate), ending at its receive time: an estimate, since a
 listener does not see the wire itself (error frames are counted, not timed).
 
 Assumptions: classic CAN (FD frames are counted and left out). Alive counters are read
 only from IDs of the DBC. This module reads the clock, to stop listening; the
-measurements themselves are the pure functions of :mod:`bench.operator.analysis.timing`.
+measurements themselves are the pure functions of :mod:`bench.operator.analysis.measures`.
 """
 
 from __future__ import annotations
@@ -32,8 +32,10 @@ from typing import Any
 import can
 
 from bench.operator.analysis.defaults import DEFAULT_FIRST_FRAME_TIMEOUT_S
-from bench.operator.analysis.timing import FrameTable, RunTiming, TimingOptions, dbc_bitrate_bps
-from bench.wire.timing import frame_bits
+from bench.operator.analysis.records import TimingOptions
+from bench.operator.analysis.tables import FrameTable
+from bench.operator.analysis.timing import RunTiming, dbc_bitrate_bps
+from bench.wire.timing.classic import frame_bits
 from dbc.database import load_database
 from dbc.e2e import COUNTER_BYTE, COUNTER_MASK
 from dbc.errors import ConfigError, RunError

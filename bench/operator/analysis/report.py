@@ -16,13 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.operator.analysis.timing import (
-    US_PER_S,
-    LoadFigures,
-    MessageTiming,
-    Percentiles,
-    RunTiming,
-)
+from bench.operator.analysis.records import US_PER_S, LoadFigures, MessageTiming, Percentiles
+from bench.operator.analysis.timing import RunTiming
 
 TIMING_JSON = "timing.json"
 LATENCY_PNG = "latency_hist.png"

@@ -44,8 +44,8 @@ Equation numbers are deliberately not cited: they could not be checked against t
 paper's text when this module was written, so sections are given from memory too.
 
 Units and arithmetic: all internal times are integer nanoseconds, like
-:class:`bench.wire.timing.BusArbiter`: C and tau_bit are rounded up to the next ns with
-:func:`bench.wire.timing.wire_time_ns` (as the arbiter does), periods, jitters and
+:class:`bench.wire.timing.arbiter.BusArbiter`: C and tau_bit are rounded up to the next ns with
+:func:`bench.wire.timing.classic.wire_time_ns` (as the arbiter does), periods, jitters and
 deadlines are rounded to the nearest ns. Integer arithmetic makes every fixed point exact
 and every iteration terminate. Non-convergence: if the level-m utilisation
 U_m = sum_{k in hep(m)} C_k / T_k is >= 1 (exact rational comparison), the busy period
@@ -62,7 +62,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
 
-from bench.wire.timing import NS_PER_S, frame_bits_worst_case, wire_time_ns
+from bench.wire.timing.classic import NS_PER_S, frame_bits_worst_case, wire_time_ns
 from dbc.errors import ConfigError
 
 MAX_DLC = 8  # classic CAN 2.0 data length

@@ -30,8 +30,9 @@ since the first frame heard. Names, senders and cycle times come from the DBC.
 
 Outputs
 -------
-Frozen dataclasses; units in the field names (``_s``, ``_ms``, ``_us``, ``_pct``). An empty
-statistic is ``nan`` with ``n = 0``, so an assertion ``x < limit`` on it fails.
+:class:`RunTiming`, whose measurements are the frozen records of
+:mod:`bench.operator.analysis.records` (units in the field names; an empty statistic is
+``nan`` with ``n = 0``, so an assertion ``x < limit`` on it fails).
 
 Assumptions
 -----------
@@ -40,55 +41,42 @@ Assumptions
   buses deliver within tens of microseconds of sending). Periods use seen times.
 * Rows with ``bits == 0`` have no place on the bus time line (the flight software's boot
   heartbeat, recorded before the run's time starts): counted, excluded from all timing.
-* Missed cycles: an inter-arrival gap longer than ``missed_gap_periods`` cycle times
-  misses ``max(1, round(gap / cycle) - 1)`` instances; an alive-counter jump of d
-  (modulo 15, :data:`dbc.e2e.COUNTER_MODULUS`) misses ``d - 1``; each gap counts the
-  larger of the two. A repeated counter is not a miss (receivers reject it).
-* Bus load: a frame occupies the wire from ``t_start`` to ``t_rx`` when both are known
-  (lockstep), else for ``bits / bitrate`` ending at its seen time (realtime, live).
-  Windows are aligned to multiples of the window length; the mean is over every window
-  from the first frame's to the last frame's.
+* Missed cycles and bus load as :mod:`bench.operator.analysis.measures` computes them
+  (its docstring), with its sources: CANoe's cycle-time checks, and worst-case response
+  times after Davis, Burns, Bril and Lukkien (2007) computed by
+  :mod:`bench.operator.analysis.rta`.
 
-Sources
+Modules
 -------
-* Cycle-time checks as CANoe's test service library does them
-  (``ChkStart_MsgAbsCycleTimeViolation``: an inter-arrival time outside [min, max] is a
-  violation; ``ChkStart_MsgRelCycleTimeViolation``: the same with the limits given as
-  factors of ``GenMsgCycleTime``). Here both windows are symmetric around the DBC cycle
-  time, ±``cycle_abs_tolerance_ms`` and ±``cycle_rel_tolerance_pct``; ``None`` disables a
-  window, as a limit of 0 does in CANoe. Messages without a cycle time are not checked.
-* Worst-case response times: Davis, Burns, Bril, Lukkien, "Controller Area Network (CAN)
-  schedulability analysis: Refuted, revisited and revised", Real-Time Systems 35 (2007),
-  computed by :mod:`bench.operator.analysis.rta` for the DBC's periodic messages at the run's
-  bitrate
-  with zero queuing jitter (the bench queues periodic frames on a fixed grid). The bound
-  runs from the queuing event to the end of the frame, so it bounds the measured
-  ``t_rx - t_ready``. In realtime and live runs the measured latency includes the host's
-  transport (hilbus, SocketCAN), not only the wire: a flag there says the transport was
-  slower than an ideal bus, not that the analysis is wrong.
+:mod:`~bench.operator.analysis.tables` reads the files into column arrays,
+:mod:`~bench.operator.analysis.measures` holds the pure measurements,
+:mod:`~bench.operator.analysis.records` the options and result records; this module
+holds :class:`RunTiming`, which applies the measurements to one run, and
+:func:`dbc_bitrate_bps`.
 
 No clock is read here.
 """
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import json
-import math
-from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
+from collections.abc import Mapping
+from dataclasses import asdict
 from functools import cached_property
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from bench.operator.analysis.defaults import (
-    DEFAULT_CYCLE_ABS_TOLERANCE_MS,
-    DEFAULT_CYCLE_REL_TOLERANCE_PCT,
-    DEFAULT_MISSED_GAP_PERIODS,
-    DEFAULT_WINDOW_MS,
+from bench.operator.analysis.measures import (
+    bus_load,
+    chain_timing,
+    cycle_time_violations,
+    data_age_s,
+    missed_cycles,
+    period_stats_s,
+    rta_bounds_s,
 )
 from bench.operator.analysis.reception import (
     RX_LOG_COLUMNS,
@@ -96,531 +84,27 @@ from bench.operator.analysis.reception import (
     fill_reception,
     receive_log,
 )
-from bench.operator.analysis.rta import messages_from_dbc, response_times
+from bench.operator.analysis.records import (
+    MS_PER_S,
+    PCT,
+    US_PER_S,
+    BusLoad,
+    ChainTiming,
+    MessageTiming,
+    Percentiles,
+    TimingOptions,
+    _is_real,
+)
+from bench.operator.analysis.tables import ChainTable, FrameTable, read_csv_columns
 from bench.results.writers import CHAIN_COLUMNS
 from bench.wire.trace import FRAME_COLUMNS
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps
 from dbc.database import load_database
-from dbc.e2e import COUNTER_MODULUS
 from dbc.errors import ConfigError, IcdError, RunError
-
-US_PER_S = 1e6
-MS_PER_S = 1e3
-PCT = 100.0
-PERCENTILE_LEVELS = (50.0, 99.0)
-NAN = float("nan")
 
 MODES = ("lockstep", "realtime", "live")
 UNKNOWN_NODE = "?"
-NO_COUNTER = -1  # recorder's counter for frames too short to carry one
-OPTIONS_SOURCE = "TimingOptions"
 RUN_SOURCE = "RunTiming"
-FIRE_COLUMN = "t_fire_cmd_rx_s"  # chains.csv: the first firing command frame received
-
-
-def _is_real(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
-
-def _json_num(value: float | None) -> float | None:
-    """``nan``/``inf`` -> None (JSON has neither)."""
-    return None if value is None or not math.isfinite(value) else value
-
-
-@dataclass(frozen=True)
-class TimingOptions:
-    """How the measurements are taken.
-
-    ``window_ms``: bus-load window length. ``cycle_abs_tolerance_ms``: absolute
-    cycle-time window, ±ms around the DBC cycle time (None: not checked).
-    ``cycle_rel_tolerance_pct``: relative window, ±% of the cycle time (None: not checked).
-    ``missed_gap_periods``: an inter-arrival gap longer than this many cycle times misses
-    at least one instance.
-    """
-
-    window_ms: float = DEFAULT_WINDOW_MS
-    cycle_abs_tolerance_ms: float | None = DEFAULT_CYCLE_ABS_TOLERANCE_MS
-    cycle_rel_tolerance_pct: float | None = DEFAULT_CYCLE_REL_TOLERANCE_PCT
-    missed_gap_periods: float = DEFAULT_MISSED_GAP_PERIODS
-
-    def __post_init__(self) -> None:
-        if not _is_real(self.window_ms) or self.window_ms <= 0:
-            raise ConfigError(OPTIONS_SOURCE, "window_ms", self.window_ms, "a finite number > 0")
-        tol = self.cycle_abs_tolerance_ms
-        if tol is not None and (not _is_real(tol) or tol < 0):
-            raise ConfigError(
-                OPTIONS_SOURCE, "cycle_abs_tolerance_ms", tol, "None or a finite number >= 0"
-            )
-        rel = self.cycle_rel_tolerance_pct
-        if rel is not None and (not _is_real(rel) or not 0 <= rel < PCT):
-            raise ConfigError(
-                OPTIONS_SOURCE, "cycle_rel_tolerance_pct", rel, "None or a number in [0, 100)"
-            )
-        gap = self.missed_gap_periods
-        if not _is_real(gap) or gap <= 1:
-            raise ConfigError(OPTIONS_SOURCE, "missed_gap_periods", gap, "a finite number > 1")
-
-
-@dataclass(frozen=True)
-class Percentiles:
-    """p50, p99 and maximum of a sample in microseconds, and the sample size ``n``."""
-
-    p50_us: float
-    p99_us: float
-    max_us: float
-    n: int
-
-    @classmethod
-    def of_seconds(cls, samples_s: np.ndarray | Sequence[float]) -> Percentiles:
-        """Percentiles (linear interpolation) of the finite samples, given in seconds."""
-        a = np.asarray(samples_s, dtype=float)
-        a = a[np.isfinite(a)] * US_PER_S
-        if a.size == 0:
-            return cls(NAN, NAN, NAN, 0)
-        p50, p99 = np.percentile(a, PERCENTILE_LEVELS)
-        return cls(float(p50), float(p99), float(a.max()), int(a.size))
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form (nan -> None)."""
-        return {
-            "p50_us": _json_num(self.p50_us),
-            "p99_us": _json_num(self.p99_us),
-            "max_us": _json_num(self.max_us),
-            "n": self.n,
-        }
-
-
-# -- tables ----------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, eq=False)
-class FrameTable:
-    """The columns of ``frames.csv`` as arrays (times in s; ``nan`` where unknown)."""
-
-    t_ready_s: np.ndarray
-    t_start_s: np.ndarray
-    t_rx_s: np.ndarray
-    can_id: np.ndarray
-    dlc: np.ndarray
-    bits: np.ndarray
-    tx: np.ndarray
-    counter: np.ndarray
-
-    def __post_init__(self) -> None:
-        n = {len(v) for v in vars(self).values()}
-        if len(n) > 1:
-            raise ConfigError("FrameTable", "columns", sorted(n), "columns of equal length")
-
-    @classmethod
-    def from_columns(cls, cols: Mapping[str, Any]) -> FrameTable:
-        """From a mapping of the ``frames.csv`` column names to sequences."""
-
-        def f(k: str) -> np.ndarray:
-            return np.asarray(cols[k], dtype=float)
-
-        def i(k: str) -> np.ndarray:
-            return np.asarray(cols[k], dtype=float).astype(np.int64)
-
-        return cls(
-            f("t_ready_s"),
-            f("t_start_s"),
-            f("t_rx_s"),
-            i("id"),
-            i("dlc"),
-            i("bits"),
-            i("tx"),
-            i("counter"),
-        )
-
-    def __len__(self) -> int:
-        return len(self.can_id)
-
-    @property
-    def seen_s(self) -> np.ndarray:
-        """``t_rx`` where known, else ``t_ready``."""
-        return np.where(np.isfinite(self.t_rx_s), self.t_rx_s, self.t_ready_s)
-
-    def select(self, mask: np.ndarray) -> FrameTable:
-        """The rows where ``mask`` is true (or at the given indices), in that order."""
-        return FrameTable(**{k: v[mask] for k, v in vars(self).items()})
-
-
-@dataclass(frozen=True, eq=False)
-class ChainTable:
-    """The columns of ``chains.csv`` as arrays (times in s; ``nan`` where none)."""
-
-    cycle: np.ndarray
-    imu_counter: np.ndarray
-    t_imu_tx_s: np.ndarray
-    t_cmd_rx_s: np.ndarray
-    t_fire_cmd_rx_s: np.ndarray
-    t_valve_open_s: np.ndarray
-
-    @classmethod
-    def from_columns(cls, cols: Mapping[str, Any]) -> ChainTable:
-        """From a mapping of the ``chains.csv`` column names to sequences.
-
-        Without ``t_fire_cmd_rx_s`` (older run folders) the last command frame stands in.
-        """
-        if FIRE_COLUMN not in cols:
-            cols = {**cols, FIRE_COLUMN: cols["t_cmd_rx_s"]}
-        return cls(*(np.asarray(cols[k], dtype=float) for k in CHAIN_COLUMNS))
-
-    @classmethod
-    def read(cls, path: Path) -> ChainTable:
-        """``chains.csv`` of a run folder (also one written before ``t_fire_cmd_rx_s``)."""
-        with open(path, newline="", encoding="utf-8") as f:
-            head = next(csv.reader(f), [])
-        cols = [c for c in CHAIN_COLUMNS if c != FIRE_COLUMN or c in head]
-        return cls.from_columns(read_csv_columns(path, cols))
-
-    def __len__(self) -> int:
-        return len(self.cycle)
-
-
-def read_csv_columns(path: Path, columns: Sequence[str]) -> dict[str, np.ndarray]:
-    """Numeric ``columns`` of a run-folder CSV file as float arrays.
-
-    A row with the wrong number of fields or a non-numeric field (the last line of a file
-    whose writer died mid-line) is dropped. Raises :class:`RunError` if the file or a
-    column is missing.
-    """
-    try:
-        f = open(path, newline="", encoding="utf-8")  # noqa: SIM115 - closed below
-    except FileNotFoundError:
-        raise RunError(f"{path}: missing (not a run folder?)") from None
-    with f:
-        reader = csv.reader(f)
-        head = next(reader, None) or []
-        missing = [c for c in columns if c not in head]
-        if missing:
-            raise RunError(f"{path}: no column(s) {', '.join(missing)} (header {head})")
-        idx = [head.index(c) for c in columns]
-        rows: list[list[float]] = []
-        for r in reader:
-            if len(r) != len(head):
-                continue
-            try:
-                rows.append([float(r[i]) for i in idx])
-            except ValueError:
-                continue
-    arr = np.array(rows, dtype=float).reshape(-1, len(columns))
-    return {c: arr[:, j] for j, c in enumerate(columns)}
-
-
-# -- pure measurements -------------------------------------------------------------------
-
-
-def period_stats_s(t_s: np.ndarray) -> tuple[float, float, float]:
-    """Mean, standard deviation (population) and max - min of the inter-arrival times [s].
-
-    ``t_s``: times of one message in increasing order. ``nan`` for fewer than two times.
-    """
-    d = np.diff(np.asarray(t_s, dtype=float))
-    if d.size == 0:
-        return NAN, NAN, NAN
-    return float(d.mean()), float(d.std()), float(d.max() - d.min())
-
-
-def cycle_time_violations(
-    intervals_s: np.ndarray,
-    cycle_s: float,
-    abs_tolerance_s: float | None,
-    rel_tolerance: float | None,
-) -> tuple[int | None, int | None]:
-    """Inter-arrival times outside the absolute and the relative window (None: not checked).
-
-    Absolute window: [cycle - abs_tolerance, cycle + abs_tolerance]; relative window:
-    [cycle (1 - rel_tolerance), cycle (1 + rel_tolerance)], ``rel_tolerance`` a fraction.
-    Limits are inclusive, as in CANoe (a violation is strictly shorter or longer).
-    """
-    d = np.asarray(intervals_s, dtype=float)
-
-    def count(lo: float, hi: float) -> int:
-        return int(np.count_nonzero((d < lo) | (d > hi)))
-
-    n_abs = (
-        None
-        if abs_tolerance_s is None
-        else count(cycle_s - abs_tolerance_s, cycle_s + abs_tolerance_s)
-    )
-    n_rel = (
-        None
-        if rel_tolerance is None
-        else count(cycle_s * (1 - rel_tolerance), cycle_s * (1 + rel_tolerance))
-    )
-    return n_abs, n_rel
-
-
-def missed_cycles(
-    t_s: np.ndarray, counters: np.ndarray, cycle_s: float | None, gap_periods: float
-) -> tuple[int, int]:
-    """Instances missed between consecutive frames of one message, and those the counter shows.
-
-    ``t_s`` in increasing order, ``counters`` the alive counters in the same order (-1 =
-    none). Per gap: ``max(1, round(gap / cycle) - 1)`` if gap > ``gap_periods`` cycles
-    (0 otherwise, and always 0 without a cycle time); counter jump d (mod 15) > 0 gives
-    d - 1. Returns (sum over gaps of the larger of the two, sum of the counter figure).
-    """
-    t = np.asarray(t_s, dtype=float)
-    c = np.asarray(counters, dtype=np.int64)
-    if t.size < 2:
-        return 0, 0
-    by_time = np.zeros(t.size - 1, dtype=np.int64)
-    if cycle_s is not None and cycle_s > 0:
-        ratio = np.diff(t) / cycle_s
-        by_time = np.where(
-            ratio > gap_periods, np.maximum(1, np.rint(ratio).astype(np.int64) - 1), 0
-        )
-    valid = (c[:-1] != NO_COUNTER) & (c[1:] != NO_COUNTER)
-    jump = (c[1:] - c[:-1]) % COUNTER_MODULUS
-    by_counter = np.where(valid & (jump > 0), jump - 1, 0)
-    return int(np.maximum(by_time, by_counter).sum()), int(by_counter.sum())
-
-
-def data_age_s(
-    src_seen_s: np.ndarray,
-    src_ready_s: np.ndarray,
-    dst_ready_s: np.ndarray,
-    dst_rx_s: np.ndarray,
-) -> np.ndarray:
-    """Age of ``src`` data when each ``dst`` frame is received [s].
-
-    For each ``dst`` frame: ``dst_rx - src_ready`` of the newest ``src`` frame seen strictly
-    before ``dst`` was queued (``dst_ready``). ``dst`` frames with an unknown time, or with
-    no earlier ``src`` frame, give no sample; samples come in ``dst`` order.
-    """
-    seen = np.asarray(src_seen_s, dtype=float)
-    ready = np.asarray(src_ready_s, dtype=float)
-    known = np.isfinite(seen)
-    seen, ready = seen[known], ready[known]
-    order = np.argsort(seen, kind="stable")
-    seen, ready = seen[order], ready[order]
-    d_ready = np.asarray(dst_ready_s, dtype=float)
-    d_rx = np.asarray(dst_rx_s, dtype=float)
-    ok = np.isfinite(d_ready) & np.isfinite(d_rx)
-    idx = np.searchsorted(seen, d_ready[ok], side="left") - 1
-    has = idx >= 0
-    age = d_rx[ok][has] - ready[idx[has]]
-    return age[np.isfinite(age)]
-
-
-def busy_intervals_s(
-    frames: FrameTable, bitrate_bps: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """When each timed frame occupied the wire: (start [s], end [s], row index).
-
-    ``t_start..t_rx`` where both are known (lockstep), else ``bits / bitrate`` ending at
-    the frame's seen time. Untimed rows (``bits == 0`` or no time at all) are left out.
-    """
-    wire_s = frames.bits / bitrate_bps
-    seen = frames.seen_s
-    modelled = np.isfinite(frames.t_start_s) & np.isfinite(frames.t_rx_s)
-    start = np.where(modelled, frames.t_start_s, seen - wire_s)
-    end = np.where(modelled, frames.t_rx_s, seen)
-    keep = np.isfinite(start) & np.isfinite(end) & (frames.bits > 0)
-    return start[keep], end[keep], np.nonzero(keep)[0]
-
-
-def window_busy_s(
-    start_s: np.ndarray, end_s: np.ndarray, t0_s: float, window_s: float, n_windows: int
-) -> np.ndarray:
-    """Busy time [s] inside each window [t0 + k w, t0 + (k + 1) w), k = 0 .. n - 1.
-
-    An interval spanning several windows is split exactly between them; overlapping
-    intervals add up (pass the frames of one wire to get a fraction <= 1). Intervals must
-    lie inside [t0, t0 + n w].
-    """
-    busy = np.zeros(n_windows)
-    a = np.asarray(start_s, dtype=float)
-    b = np.asarray(end_s, dtype=float)
-    if a.size == 0:
-        return busy
-    last = n_windows - 1
-    ka = np.clip(np.floor((a - t0_s) / window_s).astype(np.int64), 0, last)
-    kb = np.clip(np.ceil((b - t0_s) / window_s).astype(np.int64) - 1, ka, last)
-    same = ka == kb
-    np.add.at(busy, ka[same], b[same] - a[same])
-    split = ~same
-    ka, kb, a, b = ka[split], kb[split], a[split], b[split]
-    np.add.at(busy, ka, t0_s + (ka + 1) * window_s - a)
-    np.add.at(busy, kb, b - (t0_s + kb * window_s))
-    full = np.zeros(n_windows + 1)
-    np.add.at(full, ka + 1, 1.0)
-    np.add.at(full, kb, -1.0)
-    busy += np.cumsum(full)[:n_windows] * window_s
-    return busy
-
-
-def rta_bounds_s(db: Any, bitrate_bps: int) -> dict[str, float]:
-    """Worst-case response time [s] of each periodic message of ``db`` (Davis et al. 2007).
-
-    ``math.inf`` for a message whose priority level is overloaded.
-    """
-    results = response_times(messages_from_dbc(db, bitrate_bps), bitrate_bps)
-    return {name: r.response_time_s for name, r in results.items()}
-
-
-# -- results ---------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class MessageTiming:
-    """Timing of one message over a run.
-
-    ``count``: every frame of it; the statistics use its timed frames (``bits > 0``).
-    ``time_source``: which time the periods use (``t_rx``, ``t_ready``, ``mixed``, ``none``).
-    ``jitter_std_us`` / ``jitter_pp_us``: standard deviation / max - min of inter-arrival.
-    ``latency``: ``t_rx - t_ready`` where both are known. ``cycle_violations_*``: None when
-    not checked (no cycle time, or the window disabled). ``bound_us``: worst-case response
-    time from :mod:`bench.operator.analysis.rta` (None for event-driven messages).
-    """
-
-    name: str
-    can_id: int
-    sender: str
-    cycle_time_ms: float | None
-    count: int
-    time_source: str
-    period_mean_ms: float
-    jitter_std_us: float
-    jitter_pp_us: float
-    latency: Percentiles
-    missed_cycles: int
-    counter_gaps: int
-    cycle_violations_abs: int | None
-    cycle_violations_rel: int | None
-    bound_us: float | None
-
-    @property
-    def above_bound(self) -> bool:
-        """True when the measured maximum latency exceeds the worst-case bound."""
-        return (
-            self.bound_us is not None and self.latency.n > 0 and self.latency.max_us > self.bound_us
-        )
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form (nan -> None)."""
-        d = asdict(self)
-        for k in ("period_mean_ms", "jitter_std_us", "jitter_pp_us", "bound_us"):
-            d[k] = _json_num(d[k])
-        d["latency"] = self.latency.to_dict()
-        d["above_bound"] = self.above_bound
-        return d
-
-
-@dataclass(frozen=True)
-class ChainTiming:
-    """IMU sample -> command -> valve opening over the control cycles of a run.
-
-    ``imu_to_command``: last command frame received minus the IMU sample's transmission;
-    ``command_to_valve``: first valve opening minus the reception of the command frame
-    that opened it (the valve's opening delay, longer under a valve fault); ``imu_to_valve``: the
-    age of the IMU data when the first valve opens. Cycles where no valve fired have no
-    valve samples (``cycles_without_valve``).
-    """
-
-    cycles: int
-    imu_to_command: Percentiles
-    command_to_valve: Percentiles
-    imu_to_valve: Percentiles
-    cycles_without_valve: int
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form."""
-        return {
-            "cycles": self.cycles,
-            "imu_to_command": self.imu_to_command.to_dict(),
-            "command_to_valve": self.command_to_valve.to_dict(),
-            "imu_to_valve": self.imu_to_valve.to_dict(),
-            "cycles_without_valve": self.cycles_without_valve,
-        }
-
-
-def chain_timing(chains: ChainTable) -> ChainTiming:
-    """Percentiles of the three stages of the chain over every cycle of ``chains``."""
-    fired = np.isfinite(chains.t_valve_open_s)
-    return ChainTiming(
-        cycles=len(chains),
-        imu_to_command=Percentiles.of_seconds(chains.t_cmd_rx_s - chains.t_imu_tx_s),
-        command_to_valve=Percentiles.of_seconds(chains.t_valve_open_s - chains.t_fire_cmd_rx_s),
-        imu_to_valve=Percentiles.of_seconds(chains.t_valve_open_s - chains.t_imu_tx_s),
-        cycles_without_valve=int(np.count_nonzero(~fired)),
-    )
-
-
-@dataclass(frozen=True)
-class LoadFigures:
-    """Bus load of a set of frames: mean over the windows and the busiest window."""
-
-    mean_pct: float
-    peak_pct: float
-    peak_window_start_s: float
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form (nan -> None)."""
-        return {k: _json_num(v) for k, v in asdict(self).items()}
-
-
-@dataclass(frozen=True)
-class BusLoad:
-    """Bus load per window: overall and per sending node (DBC sender; ``?`` if unknown)."""
-
-    window_ms: float
-    bitrate_bps: int
-    n_windows: int
-    total: LoadFigures
-    per_node: Mapping[str, LoadFigures]
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form."""
-        return {
-            "window_ms": self.window_ms,
-            "bitrate_bps": self.bitrate_bps,
-            "n_windows": self.n_windows,
-            "total": self.total.to_dict(),
-            "per_node": {k: v.to_dict() for k, v in self.per_node.items()},
-        }
-
-
-def _load_figures(busy_s: np.ndarray, t0_s: float, window_s: float) -> LoadFigures:
-    if busy_s.size == 0:
-        return LoadFigures(NAN, NAN, NAN)
-    k = int(np.argmax(busy_s))
-    return LoadFigures(
-        mean_pct=float(busy_s.mean() / window_s * PCT),
-        peak_pct=float(busy_s[k] / window_s * PCT),
-        peak_window_start_s=t0_s + k * window_s,
-    )
-
-
-def bus_load(
-    frames: FrameTable, nodes: Sequence[str], bitrate_bps: int, window_ms: float
-) -> BusLoad:
-    """Mean and peak load per ``window_ms`` window, overall and per node.
-
-    ``nodes``: the sending node of each row of ``frames``. Windows are aligned to
-    multiples of the window length and span the first to the last busy instant.
-    """
-    window_s = window_ms / MS_PER_S
-    start, end, rows = busy_intervals_s(frames, bitrate_bps)
-    if start.size == 0:
-        empty = LoadFigures(NAN, NAN, NAN)
-        return BusLoad(window_ms, bitrate_bps, 0, empty, {})
-    t0 = math.floor(float(start.min()) / window_s) * window_s
-    n = max(1, math.ceil((float(end.max()) - t0) / window_s))
-    total = _load_figures(window_busy_s(start, end, t0, window_s, n), t0, window_s)
-    node_of = np.asarray(nodes, dtype=object)[rows]
-    per_node = {}
-    for node in sorted(set(node_of.tolist())):
-        m = node_of == node
-        per_node[node] = _load_figures(
-            window_busy_s(start[m], end[m], t0, window_s, n), t0, window_s
-        )
-    return BusLoad(window_ms, bitrate_bps, n, total, per_node)
-
-
-# -- a run -----------------------------------------------------------------------------
 
 
 def _time_source(frames: FrameTable) -> str:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from bench.station.valves.valve import FaultParams, ValveParams
+from bench.station.valves.params import FaultParams, ValveParams
 
 
 class ValveModel(Protocol):

@@ -34,7 +34,7 @@ import bisect
 
 import numpy as np
 
-from bench.station.valves.valve import (
+from bench.station.valves.params import (
     FAULT_DEGRADED,
     FAULT_DELAYED,
     FAULT_INTERMITTENT,

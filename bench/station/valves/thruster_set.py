@@ -6,9 +6,10 @@ What it does
     impulse and propellant of every thruster exactly as the rigid body integrated it.
 
 Inputs / outputs and units
-    - ``ThrusterGeometry``: ``r_thr_B_m`` the thrust application point relative to the
-      centre of mass, body axes [m]; ``d_thr_B`` the unit direction of the force the
-      thruster exerts *on the vehicle* (opposite to the plume), body axes [-].
+    - ``ThrusterGeometry`` (:mod:`bench.station.valves.geometry`): ``r_thr_B_m`` the
+      thrust application point relative to the centre of mass, body axes [m];
+      ``d_thr_B`` the unit direction of the force the thruster exerts *on the vehicle*
+      (opposite to the plume), body axes [-].
     - ``wrench_B(t_ns)`` → (fx, fy, fz, tx, ty, tz): force [N] and torque about the
       centre of mass [N·m] in body axes: F = Σ Fᵢ dᵢ, τ = Σ Fᵢ (rᵢ × dᵢ) (rᵢ × dᵢ is
       precomputed per thruster).
@@ -33,12 +34,11 @@ Faults (``set_fault(index, kind, t_ns, **params)`` / ``clear_fault(index, kind, 
     other (a leak's impulse and propellant included). The thruster set adds:
     - ``"misaligned"``, ``angle_deg`` [deg] in [−180, 180] and ``axis_B`` (unit vector,
       body axes [-]): the thrust direction is rotated by the angle about the axis
-      (right hand), d' = R(axis, angle) d (Rodrigues' rotation formula, applied through
-      the quaternion ``quat_from_axis_angle``), so both the force row d' and the torque
-      row r × d' of that thruster change; models a bent nozzle or a shifted mount. A
-      geometry change has no time history: it applies to every wrench evaluated after
-      the call (call it at the step boundary ``t_ns``); setting it again replaces the
-      angle and axis (it does not compound).
+      (right hand; :mod:`bench.station.valves.geometry`), so both the force row d' and
+      the torque row r × d' of that thruster change; models a bent nozzle or a shifted
+      mount. A geometry change has no time history: it applies to every wrench
+      evaluated after the call (call it at the step boundary ``t_ns``); setting it again
+      replaces the angle and axis (it does not compound).
     ``set_fault(index, None, t_ns)`` clears every fault of that thruster. Inactive faults
     cost nothing per step: the valve folds its faults into its thrust segments and a
     misalignment into the precomputed rows of the wrench sum.
@@ -56,30 +56,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
-from mypy_extensions import mypyc_attr
 
-from bench.station.dynamics.rigid_body import Vec3, Wrench, quat_from_axis_angle, rotate_B_to_N
+from bench.station.dynamics.rigid_body import Vec3, Wrench
 from bench.station.valves.base import ValveModel
-from bench.station.valves.valve import FAULT_KINDS, S_PER_NS, FaultParams, Valve, ValveParams
+from bench.station.valves.geometry import (
+    FAULT_MISALIGNED,
+    ThrusterGeometry,
+    _vec3,
+    misaligned_geometry,
+)
+from bench.station.valves.params import FAULT_KINDS, S_PER_NS, FaultParams, ValveParams
+from bench.station.valves.valve import Valve
 from dbc.errors import ConfigError
-from dbc.faults import MISALIGNED
 
 G0_M_S2 = 9.80665
 """Standard gravity [m/s²], used to convert impulse to propellant mass through Isp."""
-UNIT_NORM_TOL = 1e-6
-"""Allowed |‖d_thr_B‖ − 1|."""
-VEC3_LEN = 3
 SIMPSON_MID_WEIGHT = 4.0
 SIMPSON_DIVISOR = 6.0
-FAULT_MISALIGNED = MISALIGNED
 THRUSTER_FAULT_KINDS = FAULT_KINDS | {FAULT_MISALIGNED}
 """Every fault kind ``ThrusterSet.set_fault`` accepts."""
-MISALIGNED_PARAMS = ("angle_deg", "axis_B")
-MAX_MISALIGNMENT_DEG = 180.0
-"""|angle_deg| of a ``misaligned`` fault is at most this (any rotation is reachable)."""
 CHILD_SEED_BOUND = 2**63 - 1
 """Exclusive upper bound of the per-valve seeds drawn from the constructor's ``rng``."""
 
@@ -90,47 +87,52 @@ ThrusterStatus = tuple[bool, bool, bool]
 """(coil_energised, open, current) of one valve, as ``Valve.status``."""
 
 
-def _vec3(value: object, source: str, key: str) -> Vec3:
-    expected = "3 finite numbers"
-    try:
-        seq = tuple(float(x) for x in value)  # type: ignore[attr-defined]
-    except (TypeError, ValueError):
-        raise ConfigError(source, key, value, expected) from None
-    if len(seq) != VEC3_LEN or not all(math.isfinite(x) for x in seq):
-        raise ConfigError(source, key, value, expected)
-    return (seq[0], seq[1], seq[2])
-
-
-@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
-@dataclass(frozen=True)
-class ThrusterGeometry:
-    """Mounting of one thruster: application point [m] and unit force direction, body axes."""
-
-    r_thr_B_m: Vec3
-    d_thr_B: Vec3
-    source: str = field(default="ThrusterGeometry", compare=False, repr=False, kw_only=True)
-    torque_arm_B_m: Vec3 = field(init=False, repr=False, compare=False)
-    """r × d [m]: torque per newton of thrust."""
-
-    def __post_init__(self) -> None:
-        # getattr: the fields as given (compiled code would cast a read to Vec3 first)
-        r = _vec3(getattr(self, "r_thr_B_m"), self.source, "r_thr_B_m")  # noqa: B009
-        d = _vec3(getattr(self, "d_thr_B"), self.source, "d_thr_B")  # noqa: B009
-        norm = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-        if not abs(norm - 1.0) <= UNIT_NORM_TOL:
+def _per_thruster_params(
+    params: ValveParams | Sequence[ValveParams], n: int, source: str
+) -> tuple[ValveParams, ...]:
+    """One ``ValveParams`` per thruster: ``params`` shared, or a sequence of ``n``."""
+    if isinstance(params, ValveParams):
+        plist: tuple[ValveParams, ...] = (params,) * n
+    else:
+        plist = tuple(params)
+        if len(plist) != n or not all(isinstance(p, ValveParams) for p in plist):
             raise ConfigError(
-                self.source,
-                "d_thr_B",
-                self.d_thr_B,
-                f"a unit vector (|norm - 1| <= {UNIT_NORM_TOL:g})",
+                source,
+                "params",
+                params,
+                f"a ValveParams or {n} of them (one per thruster)",
             )
-        object.__setattr__(self, "r_thr_B_m", r)
-        object.__setattr__(self, "d_thr_B", d)
-        object.__setattr__(
-            self,
-            "torque_arm_B_m",
-            (r[1] * d[2] - r[2] * d[1], r[2] * d[0] - r[0] * d[2], r[0] * d[1] - r[1] * d[0]),
+    return plist
+
+
+def _valve_rngs(
+    rng: np.random.Generator | None, n: int, source: str
+) -> list[np.random.Generator | None]:
+    """One generator per valve, seeded from ``rng`` (None: no generator)."""
+    if rng is None:
+        rngs: list[np.random.Generator | None] = [None] * n
+    elif isinstance(rng, np.random.Generator):
+        seeds = rng.integers(0, CHILD_SEED_BOUND, size=n).tolist()
+        rngs = [np.random.default_rng(s) for s in seeds]
+    else:
+        raise ConfigError(source, "rng", rng, "None or a numpy Generator")
+    return rngs
+
+
+def _checked_index(index: int, kind: str | None, n: int, source: str) -> int:
+    """``index`` if it names one of ``n`` thrusters and ``kind`` is a fault kind (or None)."""
+    if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < n:
+        raise ConfigError(
+            f"{source}.set_fault({kind!r})", "index", index, f"an integer in [0, {n})"
         )
+    if kind is not None and kind not in THRUSTER_FAULT_KINDS:
+        raise ConfigError(
+            f"{source}.set_fault({kind!r})",
+            "kind",
+            kind,
+            f"None or one of {sorted(THRUSTER_FAULT_KINDS)}",
+        )
+    return index
 
 
 class ThrusterSet:
@@ -168,26 +170,10 @@ class ThrusterSet:
         geoms = tuple(geometries)
         if not geoms or not all(isinstance(g, ThrusterGeometry) for g in geoms):
             raise ConfigError(source, "geometries", geometries, "one or more ThrusterGeometry")
-        if isinstance(params, ValveParams):
-            plist: tuple[ValveParams, ...] = (params,) * len(geoms)
-        else:
-            plist = tuple(params)
-            if len(plist) != len(geoms) or not all(isinstance(p, ValveParams) for p in plist):
-                raise ConfigError(
-                    source,
-                    "params",
-                    params,
-                    f"a ValveParams or {len(geoms)} of them (one per thruster)",
-                )
+        plist = _per_thruster_params(params, len(geoms), source)
         if isinstance(g0_m_s2, bool) or not (math.isfinite(g0_m_s2) and g0_m_s2 > 0.0):
             raise ConfigError(source, "g0_m_s2", g0_m_s2, "a finite number > 0")
-        if rng is None:
-            rngs: list[np.random.Generator | None] = [None] * len(geoms)
-        elif isinstance(rng, np.random.Generator):
-            seeds = rng.integers(0, CHILD_SEED_BOUND, size=len(geoms)).tolist()
-            rngs = [np.random.default_rng(s) for s in seeds]
-        else:
-            raise ConfigError(source, "rng", rng, "None or a numpy Generator")
+        rngs = _valve_rngs(rng, len(geoms), source)
         self._source = source
         self.geometries = geoms
         self._geometries_ref = geoms
@@ -265,20 +251,21 @@ class ThrusterSet:
         ``"misaligned"`` takes ``angle_deg`` and ``axis_B`` (module docstring). ``None``
         clears every fault of the thruster. Bad index, kind or parameters: ``ConfigError``.
         """
-        i = self._check_index(index, kind)
+        i = _checked_index(index, kind, len(self.valves), self._source)
         if kind is None:
             self.valves[i].set_fault(None, t_ns, **params)
             if self._misalignment.pop(i, None) is not None:
                 self._build_rows()
         elif kind == FAULT_MISALIGNED:
-            self._misalignment[i] = self._misaligned(i, params)
+            source = f"{self._source}.set_fault({FAULT_MISALIGNED!r})"
+            self._misalignment[i] = misaligned_geometry(self.geometries[i], params, source)
             self._build_rows()
         else:
             self.valves[i].set_fault(kind, t_ns, **params)
 
     def clear_fault(self, index: int, kind: str, t_ns: int | None = None) -> None:
         """Clear fault ``kind`` of thruster ``index`` at ``t_ns``; a no-op if it is inactive."""
-        i = self._check_index(index, kind)
+        i = _checked_index(index, kind, len(self.valves), self._source)
         if kind == FAULT_MISALIGNED:
             if self._misalignment.pop(i, None) is not None:
                 self._build_rows()
@@ -307,63 +294,6 @@ class ThrusterSet:
     def dropped_pulses(self) -> tuple[int, ...]:
         """Coil pulses dropped by ``intermittent`` faults so far, per thruster."""
         return tuple(v.dropped_pulses for v in self.valves)
-
-    def _check_index(self, index: int, kind: str | None) -> int:
-        n = len(self.valves)
-        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < n:
-            raise ConfigError(
-                f"{self._source}.set_fault({kind!r})", "index", index, f"an integer in [0, {n})"
-            )
-        if kind is not None and kind not in THRUSTER_FAULT_KINDS:
-            raise ConfigError(
-                f"{self._source}.set_fault({kind!r})",
-                "kind",
-                kind,
-                f"None or one of {sorted(THRUSTER_FAULT_KINDS)}",
-            )
-        return index
-
-    def _misaligned(
-        self, index: int, params: dict[str, object]
-    ) -> tuple[FaultParams, ThrusterGeometry]:
-        """Validated ``misaligned`` parameters and the rotated geometry of ``index``."""
-        source = f"{self._source}.set_fault({FAULT_MISALIGNED!r})"
-        for key, value in params.items():
-            if key not in MISALIGNED_PARAMS:
-                raise ConfigError(
-                    source, key, value, f"no such parameter (expected {list(MISALIGNED_PARAMS)})"
-                )
-        for key in MISALIGNED_PARAMS:
-            if key not in params:
-                raise ConfigError(source, key, None, f"a value (required by {FAULT_MISALIGNED!r})")
-        angle = params["angle_deg"]
-        if (
-            isinstance(angle, bool)
-            or not isinstance(angle, (int, float))
-            or not (math.isfinite(angle) and abs(angle) <= MAX_MISALIGNMENT_DEG)
-        ):
-            raise ConfigError(
-                source,
-                "angle_deg",
-                angle,
-                f"a number in [-{MAX_MISALIGNMENT_DEG:g}, {MAX_MISALIGNMENT_DEG:g}]",
-            )
-        axis = _vec3(params["axis_B"], source, "axis_B")
-        if not abs(math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2) - 1.0) <= UNIT_NORM_TOL:
-            raise ConfigError(
-                source,
-                "axis_B",
-                params["axis_B"],
-                f"a unit vector (|norm - 1| <= {UNIT_NORM_TOL:g})",
-            )
-        nominal = self.geometries[index]
-        d = rotate_B_to_N(quat_from_axis_angle(axis, math.radians(angle)), nominal.d_thr_B)
-        # Renormalise away round-off so the geometry stays a unit direction.
-        n = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-        rotated = ThrusterGeometry(
-            nominal.r_thr_B_m, (d[0] / n, d[1] / n, d[2] / n), source=nominal.source
-        )
-        return {"angle_deg": float(angle), "axis_B": axis}, rotated
 
     # --- the plant's inputs ---------------------------------------------------------
     def wrench_B(self, t_ns: int) -> Wrench:

@@ -15,7 +15,8 @@ from bench.operator.analysis.rta import (
     messages_from_dbc,
     response_times,
 )
-from bench.wire.timing import NS_PER_S, BusArbiter, frame_bits_worst_case
+from bench.wire.timing.arbiter import BusArbiter
+from bench.wire.timing.classic import NS_PER_S, frame_bits_worst_case
 from dbc.database import load_database
 from dbc.errors import ConfigError
 

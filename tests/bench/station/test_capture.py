@@ -14,8 +14,8 @@ from bench.station.dynamics.rigid_body import (
     rotate_B_to_N,
 )
 from bench.station.dynamics.translation import InertialTranslation
+from bench.station.valves.params import ValveParams
 from bench.station.valves.thruster_set import ThrusterGeometry, ThrusterSet
-from bench.station.valves.valve import ValveParams
 
 REL_TOL = 1e-12
 ABS_TOL = 1e-12

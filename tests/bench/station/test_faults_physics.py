@@ -22,15 +22,15 @@ from bench.station.dynamics.rigid_body import (
 from bench.station.sensors.accelerometer import Accelerometer, AccelerometerParams
 from bench.station.sensors.gyro import Gyro, GyroParams, InertialSensor, SensorOutageError
 from bench.station.sensors.star_tracker import RAD_PER_ARCSEC, StarTracker, StarTrackerParams
-from bench.station.valves.thruster_set import G0_M_S2, ThrusterGeometry, ThrusterSet
-from bench.station.valves.valve import (
+from bench.station.valves.params import (
     HISTORY_NS,
     NEVER_NS,
     OPEN_THRESHOLD_FRACTION,
     THRUST_CUTOFF_FRACTION,
-    Valve,
     ValveParams,
 )
+from bench.station.valves.thruster_set import G0_M_S2, ThrusterGeometry, ThrusterSet
+from bench.station.valves.valve import Valve
 from dbc.errors import ConfigError
 
 SEED = 20240611

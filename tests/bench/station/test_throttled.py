@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
+from bench.station.valves.params import ValveParams
 from bench.station.valves.throttled import ThrottledValve
 from bench.station.valves.thruster_set import ThrusterGeometry, ThrusterSet
-from bench.station.valves.valve import ValveParams
 from dbc.errors import ConfigError
 
 PERIOD_NS = 20_000_000

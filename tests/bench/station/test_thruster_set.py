@@ -15,8 +15,9 @@ from bench.station.dynamics.rigid_body import (
     rk4_step,
     state_omega_BN_B,
 )
+from bench.station.valves.params import ValveParams
 from bench.station.valves.thruster_set import G0_M_S2, ThrusterGeometry, ThrusterSet
-from bench.station.valves.valve import Valve, ValveParams
+from bench.station.valves.valve import Valve
 from dbc.errors import ConfigError
 
 MS = 1_000_000  # ns per millisecond

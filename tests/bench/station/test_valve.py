@@ -8,13 +8,13 @@ import math
 import numpy as np
 import pytest
 
-from bench.station.valves.valve import (
+from bench.station.valves.params import (
     NEVER_NS,
     OPEN_THRESHOLD_FRACTION,
     THRUST_CUTOFF_FRACTION,
-    Valve,
     ValveParams,
 )
+from bench.station.valves.valve import Valve
 from dbc.errors import ConfigError
 from tests.values import same_value
 

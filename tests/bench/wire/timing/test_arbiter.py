@@ -1,4 +1,5 @@
-"""Bus timing model: frame length vs an independent stuffer; arbitration, errors, load."""
+"""Bus arbitration: priority, errors and retransmission, bus-off, FD frames, and the load
+of its deliveries."""
 
 from __future__ import annotations
 
@@ -7,30 +8,23 @@ import random
 
 import pytest
 
-from bench.wire.timing import (
+from bench.wire.timing.arbiter import (
     ERROR_FRAME_BITS,
     BusArbiter,
     Delivery,
-    FdBits,
     bus_off_recovery_ns,
-    busy_ns_per_window,
-    crc15,
     failed_attempt_bits,
-    frame_bits,
-    frame_bits_fd,
-    frame_bits_worst_case,
-    frame_bitstream,
+)
+from bench.wire.timing.classic import frame_bits, wire_time_ns
+from bench.wire.timing.fd import FdBits, frame_bits_fd, wire_time_fd_ns
+from bench.wire.timing.load import (
+    busy_ns_per_window,
     load_per_window,
     load_per_window_by_node,
     mean_peak_load,
-    stuff_count,
-    wire_time_fd_ns,
-    wire_time_ns,
 )
 
-N_RANDOM = 10_000  # the issue asks for 10 000 random frames
 SEED = 5
-TAIL_BITS = 13  # CRC delimiter, ACK slot + delimiter, EOF 7, intermission 3
 BITRATE_125K = 125_000
 BITRATE_500K = 500_000
 BITRATE_1M = 1_000_000
@@ -41,50 +35,6 @@ ERROR_FRAME_WORST_BITS = 6 + 6 + 8  # flag, superposed flags, delimiter
 INTERMISSION_BITS = 3
 BUS_OFF_BITS = 128 * 11
 LOAD_FRACTION_TOL_NS = 1e-3  # float round-off of fraction * window length, summed
-
-
-def _reference_stuffed_length(bits: list[int]) -> int:
-    """Independent stuffer: emit bits, inserting the complement after 5 equal bits."""
-    out: list[int] = []
-    for b in bits:
-        out.append(b)
-        if len(out) >= 5 and len(set(out[-5:])) == 1:
-            out.append(1 - out[-1])
-    return len(out)
-
-
-def test_frame_length_matches_independent_stuffer() -> None:
-    """frame_bits == reference stuffing of the same bit stream, both ID lengths, all DLCs."""
-    rng = random.Random(SEED)
-    for _ in range(N_RANDOM):
-        ext = rng.random() < 0.5
-        can_id = rng.randrange(1 << (29 if ext else 11))
-        data = rng.randbytes(rng.randrange(9))
-        ref = _reference_stuffed_length(frame_bitstream(can_id, data, ext)) + TAIL_BITS
-        assert frame_bits(can_id, data, ext) == ref
-        assert frame_bits(can_id, data, ext) <= frame_bits_worst_case(len(data), ext)
-
-
-def test_payload_changes_length() -> None:
-    """An all-zero payload needs more stuff bits than an alternating 0x55 payload."""
-    zeros, alt = frame_bits(0x123, bytes(8)), frame_bits(0x123, bytes([0x55] * 8))
-    assert zeros > alt
-    assert (
-        alt
-        == len(frame_bitstream(0x123, bytes([0x55] * 8)))
-        + stuff_count(frame_bitstream(0x123, bytes([0x55] * 8)))
-        + TAIL_BITS
-    )
-
-
-def test_crc15_detects_single_bit_errors() -> None:
-    """CRC-15 changes for every single flipped bit of a stream."""
-    bits = frame_bitstream(0x2A5, b"\x01\x02\x03")[:-15]
-    ref = crc15(bits)
-    for i in range(len(bits)):
-        flipped = bits.copy()
-        flipped[i] ^= 1
-        assert crc15(flipped) != ref
 
 
 def test_arbitration_lowest_id_first_non_preemptive() -> None:

@@ -7,18 +7,20 @@ import random
 
 import pytest
 
-from bench.wire.timing import (
-    FdBits,
-    fd_dlc2len,
-    fd_len2dlc,
+from bench.wire.timing.classic import (
     frame_bits,
-    frame_bits_fd,
-    frame_bits_fd_worst_case,
     frame_bits_worst_case,
     frame_bitstream,
     stuff_count,
-    wire_time_fd_ns,
     wire_time_ns,
+)
+from bench.wire.timing.fd import (
+    FdBits,
+    fd_dlc2len,
+    fd_len2dlc,
+    frame_bits_fd,
+    frame_bits_fd_worst_case,
+    wire_time_fd_ns,
 )
 
 N_RANDOM_FD = 2500
