@@ -67,6 +67,8 @@ COMPILED = [
     "bench/station/sensors/accelerometer.py",
     "bench/station/sensors/star_tracker.py",
     "bench/node.py",
+    "bench/lockstep.py",
+    "bench/realtime.py",
     "bench/wire/trace.py",
     "bench/results/writers.py",
     "flight_sw/quaternion.py",

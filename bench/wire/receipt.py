@@ -1,7 +1,8 @@
 """The fate of a frame on receipt: one path for lockstep and realtime.
 
-In: a frame read from the bus, the bench's time of receipt [ns] (modelled in lockstep,
-measured in realtime), and in lockstep the control cycle whose commands are awaited.
+In: a frame read from the bus, the time it was read on the bench's clock [ns] (wall
+clock: it decides whether a message's alive-counter stream is still live, which a
+restarted sender's is not), and in lockstep the control cycle whose commands are awaited.
 Out: one :class:`Arrival` per copy of the frame that reaches the bench, each either taken
 (its decoded signals) or rejected with its cause; nothing else changes for a rejected frame.
 

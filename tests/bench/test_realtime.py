@@ -21,7 +21,8 @@ from pathlib import Path
 
 import can
 
-from bench.node import NS_PER_S, RT_FRAMES_PER_PASS, BenchNode, Clock
+from bench.node import NS_PER_S, BenchNode, Clock
+from bench.realtime import RT_FRAMES_PER_PASS, Realtime
 from bench.scenario.load import load_scenario
 from bench.station.plant import STEP_NS
 from dbc.codec import Encoder, cycle_time_ns
@@ -113,12 +114,17 @@ def _run(tmp_path: Path, duration_s: float, speedup: int,
     bus = open_bus(spec)
     counts = Counts()
 
-    class CountingNode(BenchNode):
+    class CountingLoop(Realtime):
         """Counts the frames the realtime loop hands to its frame handler."""
 
-        def _on_realtime_frame(self, msg: can.Message, clock: Clock) -> None:
+        def frame(self, msg: can.Message) -> None:
             counts.handled += 1
-            super()._on_realtime_frame(msg, clock)
+            super().frame(msg)
+
+    class CountingNode(BenchNode):
+        """A bench node whose realtime loop counts the frames it handles."""
+
+        realtime_loop = CountingLoop
 
     scenario = load_scenario(SCENARIO, overrides)
     node = CountingNode(scenario, db, bus, tmp_path, "realtime", 1, spec)
@@ -226,7 +232,7 @@ def test_a_command_that_finds_the_plant_behind_counts_it_late(tmp_path: Path) ->
     node = BenchNode(load_scenario(SCENARIO), db, bus, tmp_path, "realtime", 1, spec)
     msg = db.get_message_by_name("THR_CMD_0")
     sig = {s.name: 0 for s in msg.signals if s.name not in ("CRC", "AliveCounter")}
-    node._on_realtime_frame(Encoder(db).message("THR_CMD_0", sig), FixedClock(at_ns=STALL_NS))
+    Realtime(node, FixedClock(at_ns=STALL_NS)).frame(Encoder(db).message("THR_CMD_0", sig))
     bus.shutdown()
     misses = node.close(0.0)["deadline_misses"]
     assert misses["bench_late"] == 1
