@@ -91,12 +91,9 @@ def _default_out(name: str) -> Path:
 
 
 def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
-    from bench.operator.orchestrator import (
-        DEFAULT_FSW_CMD,
-        RunOptions,
-        run_scenario,
-        scenario_warnings,
-    )
+    from bench.operator.fsw_process import DEFAULT_FSW_CMD
+    from bench.operator.orchestrator import RunOptions, run_scenario
+    from bench.operator.run_warnings import scenario_warnings
     from bench.scenario.load import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)

@@ -310,7 +310,7 @@ class HilRunner:
         ``timing``: :class:`~bench.operator.analysis.records.TimingOptions` for the measurements;
         ``fresh``: do not reuse an identical lockstep run of this session.
         """
-        from bench.operator.orchestrator import DEFAULT_FSW_CMD
+        from bench.operator.fsw_process import DEFAULT_FSW_CMD
 
         config = self._session.config
         if fsw_cmd is UNSET:

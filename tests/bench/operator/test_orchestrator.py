@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from bench.operator import orchestrator
-from bench.operator.orchestrator import duration_warnings
+from bench.operator.run_warnings import duration_warnings, overrun_warning
 from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError, RefusedConfigError
 
@@ -77,7 +77,7 @@ def test_bench_refusing_its_input_before_the_run_says_why(
 
 def test_overrun_warning_names_the_member_that_stalled() -> None:
     """Drops are attributed per receiving pid: the bench, the flight software or another."""
-    w = orchestrator.overrun_warning({77: 3}, {10: 6, 77: 1}, bench_pid=10, fsw_pid=20,
+    w = overrun_warning({77: 3}, {10: 6, 77: 1}, bench_pid=10, fsw_pid=20,
                                      stall_s=0.01)
     assert w.startswith("10 frames were dropped for bus members that did not read for 10 ms")
     assert "6 from the flight software to the bench (pid 10)" in w

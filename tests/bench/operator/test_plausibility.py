@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from bench.operator.orchestrator import scenario_warnings
 from bench.operator.plausibility import MAX_RATIO, MIN_RATIO, mass_warnings
+from bench.operator.run_warnings import scenario_warnings
 from bench.scenario.load import load_scenario
 
 SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"

@@ -1,0 +1,147 @@
+"""The flight-software process as the bench runs it: its command line, start, stop, report.
+
+The bench starts the flight software by command (``--fsw-cmd``, ours by default), exactly
+as a real bench starts someone else's flight-software binary, so the bench never imports
+it. Placeholders in the command (plain names only): ``{bus}``, ``{mode}``, ``{config}``
+(the configuration file, dbc.contract.FswConfig), ``{stats}`` (where it may write its
+statistics or its refusal, dbc.contract), ``{rx_log}`` (realtime: when it received each
+frame) and ``{run_dir}``. On Linux the child is asked to get SIGTERM when the bench
+process dies (even by SIGKILL). At the end it gets SIGTERM and ``FSW_TERM_TIMEOUT_S`` to
+write its statistics before it is killed. docs/icd.md states the rules for another team.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import os
+import selectors
+import shlex
+import signal
+import string
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+from bench.operator.analysis.reception import RX_LOG_FILE
+from dbc.contract import REFUSAL_SCHEMA, FswRefusal
+from dbc.errors import ConfigError
+
+DEFAULT_FSW_CMD = (
+    f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
+    "--config {config} --stats {stats} --rx-log {rx_log}"
+)
+FSW_TERM_TIMEOUT_S = 5.0
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+LOG_TAIL_LINES = 5
+
+
+PLACEHOLDERS = ("bus", "mode", "config", "stats", "run_dir", "rx_log")
+
+
+def fsw_argv(template: str, bus: str, mode: str, out: Path, config: Path, stats: Path
+             ) -> list[str]:
+    """The flight software's command line: ``template`` split as a shell would, with its
+    placeholders (plain names of :data:`PLACEHOLDERS` only: no attribute, index, format
+    or conversion) replaced."""
+    values = {"bus": bus, "mode": mode, "config": str(config), "stats": str(stats),
+              "run_dir": str(out), "rx_log": str(out / RX_LOG_FILE)}
+    allowed = " ".join(f"{{{p}}}" for p in PLACEHOLDERS)
+    try:
+        args = shlex.split(template)
+    except ValueError as exc:
+        raise ConfigError("command line", "--fsw-cmd", template,
+                          f"a command line a shell can split ({exc})") from exc
+    argv: list[str] = []
+    for a in args:
+        parts: list[str] = []
+        try:
+            parsed = list(string.Formatter().parse(a))
+        except ValueError as exc:
+            raise ConfigError("command line", "--fsw-cmd", template,
+                              f"placeholders among {allowed} ({exc}; write {{{{ for a brace)"
+                              ) from exc
+        for literal, name, spec, conv in parsed:
+            parts.append(literal)
+            if name is None:
+                continue
+            if name not in values or spec or conv:
+                raise ConfigError("command line", "--fsw-cmd", template,
+                                  f"placeholders among {allowed}, as plain names (found "
+                                  f"{{{name}{'!' + conv if conv else ''}"
+                                  f"{':' + spec if spec else ''}}})")
+            parts.append(values[name])
+        argv.append("".join(parts))
+    return argv
+
+
+
+def die_with_parent() -> None:
+    """In the child: ask Linux for SIGTERM when the bench process dies (even by SIGKILL).
+
+    Elsewhere (macOS) this is a no-op; the flight software then notices the silence itself.
+    """
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+
+def stop(proc: subprocess.Popen[bytes]) -> int | None:
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGTERM)
+        try:
+            proc.wait(FSW_TERM_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+    return proc.returncode
+
+
+
+def log_tail(log: Path, lines: int = LOG_TAIL_LINES) -> list[str]:
+    if not log.exists():
+        return []
+    return log.read_text(encoding="utf-8", errors="replace").splitlines()[-lines:]
+
+
+def fsw_report(stats: Path, rc: int | None, out: Path) -> dict[str, Any]:
+    """The flight software's part of summary.json: its exit code, its statistics or its
+    refusal (dbc.contract records), and its log's tail when it failed."""
+    rep: dict[str, Any] = {"exit_code": rc}
+    if stats.exists():
+        try:
+            data = json.loads(stats.read_text(encoding="utf-8"))
+            if isinstance(data, dict) and data.get("schema") == REFUSAL_SCHEMA:
+                refusal = FswRefusal.from_json(data, str(stats))
+                rep.update(refused=refusal.message, refusal=refusal.to_json())
+            elif isinstance(data, dict):
+                rep.update(data)
+            else:
+                rep["stats_error"] = f"{stats}: not a JSON object"
+        except (OSError, json.JSONDecodeError, ConfigError) as exc:
+            rep["stats_error"] = str(exc)
+    else:
+        rep["stats_error"] = "flight software wrote no statistics"
+    if rc not in (0, None):
+        rep["log_tail"] = log_tail(out / "fsw.log")
+    return rep
+
+
+def wait_for_exit(out: Path) -> None:
+    """After the bench died: give its flight-software child time to write its statistics."""
+    try:
+        pid = int((out / "fsw.pid").read_text(encoding="utf-8"))
+        fd = os.pidfd_open(pid)
+    except (OSError, ValueError, AttributeError):
+        return
+    try:
+        sel = selectors.DefaultSelector()
+        sel.register(fd, selectors.EVENT_READ)  # readable when the process has exited
+        sel.select(timeout=FSW_TERM_TIMEOUT_S)
+        sel.close()
+    finally:
+        os.close(fd)
+
+
