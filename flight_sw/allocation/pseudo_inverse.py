@@ -66,7 +66,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -74,6 +73,7 @@ import numpy as np
 from scipy.optimize import linprog, lsq_linear
 
 from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.allocation.base import AllocationResult
 
 MAX_DEMAND_DIM = 6
@@ -104,13 +104,8 @@ class PseudoInverseParams:
     exact_repair: bool = True
 
     def __post_init__(self) -> None:
-        t = self.max_thrust_N
-        if not (
-            isinstance(t, numbers.Real) and not isinstance(t, bool) and math.isfinite(t) and t > 0
-        ):
-            raise ConfigError("PseudoInverseParams", "max_thrust_N", t, "a finite number > 0")
-        if not isinstance(self.exact_repair, bool):
-            raise ConfigError("PseudoInverseParams", "exact_repair", self.exact_repair, "a bool")
+        check.positive("PseudoInverseParams", "max_thrust_N", self.max_thrust_N, unit="N")
+        check.flag("PseudoInverseParams", "exact_repair", self.exact_repair)
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:

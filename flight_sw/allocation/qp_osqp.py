@@ -65,7 +65,6 @@ SIAM J. Optim. 13(3) 865–888 (primal-dual active set); Nocedal & Wright 2006, 
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -75,6 +74,7 @@ import osqp
 import scipy.sparse as sp
 
 from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.allocation import dense
 from flight_sw.allocation.base import AllocationResult
 from flight_sw.allocation.dense import AT_LOWER, AT_UPPER, FREE  # active-set states of box_qp
@@ -125,25 +125,12 @@ def osqp_settings(warm_start: bool, stage_one: bool = False) -> dict[str, Any]:
     }
 
 
-def is_real(value: object) -> bool:
-    """True for a real number that is not a bool."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
 def check_bound_spec(source: str, key: str, value: object) -> None:
     """Raise ConfigError unless ``value`` is a finite number or a non-empty tuple of them."""
-    expected = "a finite number or a tuple of finite numbers (one per thruster)"
-    items = value if isinstance(value, tuple) else (value,)
-    if not items or not all(is_real(v) and math.isfinite(float(v)) for v in items):
-        raise ConfigError(source, key, value, expected)
-
-
-def check_positive(source: str, key: str, value: object, allow_zero: bool) -> None:
-    """Raise ConfigError unless ``value`` is a finite real > 0 (or >= 0)."""
-    ok = is_real(value) and math.isfinite(float(value))  # type: ignore[arg-type]
-    ok = ok and (float(value) >= 0.0 if allow_zero else float(value) > 0.0)  # type: ignore[arg-type]
-    if not ok:
-        raise ConfigError(source, key, value, "a finite number >= 0" if allow_zero else "> 0")
+    if isinstance(value, tuple):
+        check.vector(source, key, value, None)
+    else:
+        check.number(source, key, value)
 
 
 def thrust_bounds(
@@ -492,16 +479,13 @@ class BoundedQpParams:
     def __post_init__(self) -> None:
         check_bound_spec(_SOURCE, "upper_N", self.upper_N)
         check_bound_spec(_SOURCE, "lower_N", self.lower_N)
-        check_positive(_SOURCE, "regularization", self.regularization, allow_zero=True)
+        check.non_negative(_SOURCE, "regularization", self.regularization)
         w = self.demand_weights
-        if w is not None and not (
-            isinstance(w, tuple)
-            and 1 <= len(w) <= MAX_DEMAND_DIM
-            and all(is_real(x) and math.isfinite(float(x)) and float(x) > 0 for x in w)
-        ):
-            raise ConfigError(_SOURCE, "demand_weights", w, "a tuple of 1..6 numbers > 0")
-        if not isinstance(self.warm_start, bool):
-            raise ConfigError(_SOURCE, "warm_start", self.warm_start, "a bool")
+        if w is not None:
+            check.vector(_SOURCE, "demand_weights", w, None, 0.0, lo_open=True)
+            if not (isinstance(w, tuple) and len(w) <= MAX_DEMAND_DIM):
+                raise ConfigError(_SOURCE, "demand_weights", w, "a tuple of 1..6 numbers > 0")
+        check.flag(_SOURCE, "warm_start", self.warm_start)
 
 
 class BoundedQpAllocator:

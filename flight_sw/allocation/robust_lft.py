@@ -71,6 +71,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.allocation.base import AllocationResult
 from flight_sw.allocation.qp_osqp import (
     ACTIVE_RTOL,
@@ -83,9 +84,7 @@ from flight_sw.allocation.qp_osqp import (
     check_bound_spec,
     check_demand,
     check_effectiveness,
-    check_positive,
     frozen,
-    is_real,
     monotone_root,
     parse_mask,
     range_basis_T,
@@ -116,16 +115,6 @@ _SOURCE = "RobustLftParams"
 Matrix = tuple[tuple[float, ...], ...]
 
 
-def _matrix(source: str, key: str, value: object) -> None:
-    ok = isinstance(value, tuple) and len(value) > 0
-    if ok and isinstance(value, tuple):
-        ok = all(isinstance(r, tuple) and len(r) == len(value[0]) > 0 for r in value)
-        ok = ok and all(is_real(x) for r in value for x in r)
-        ok = ok and bool(np.all(np.isfinite(np.array(value, dtype=float))))
-    if not ok:
-        raise ConfigError(source, key, value, "a non-empty rectangular tuple of tuples of numbers")
-
-
 @dataclass(frozen=True)
 class RobustLftParams:
     """Parameters of the linear-fractional robust allocator.
@@ -153,17 +142,16 @@ class RobustLftParams:
     def __post_init__(self) -> None:
         check_bound_spec(_SOURCE, "upper_N", self.upper_N)
         check_bound_spec(_SOURCE, "lower_N", self.lower_N)
-        check_positive(_SOURCE, "rho", self.rho, allow_zero=True)
-        check_positive(_SOURCE, "regularization", self.regularization, allow_zero=True)
-        if self.e_shape is not None:
-            _matrix(_SOURCE, "e_shape", self.e_shape)
-        if self.h_matrix is not None:
-            _matrix(_SOURCE, "h_matrix", self.h_matrix)
-        it = self.max_iter
-        if not (isinstance(it, int) and not isinstance(it, bool) and it >= 1):
-            raise ConfigError(_SOURCE, "max_iter", it, "an int >= 1")
-        if not isinstance(self.warm_start, bool):
-            raise ConfigError(_SOURCE, "warm_start", self.warm_start, "a bool")
+        check.non_negative(_SOURCE, "rho", self.rho)
+        check.non_negative(_SOURCE, "regularization", self.regularization)
+        for key in ("e_shape", "h_matrix"):
+            value = getattr(self, key)
+            if value is not None and not isinstance(value, tuple):
+                raise ConfigError(_SOURCE, key, value, "a tuple of tuples of finite numbers")
+            if value is not None:
+                check.matrix(_SOURCE, key, value)
+        check.integer(_SOURCE, "max_iter", self.max_iter, 1)
+        check.flag(_SOURCE, "warm_start", self.warm_start)
 
 
 class RobustLftAllocator:

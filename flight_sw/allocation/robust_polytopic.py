@@ -90,6 +90,7 @@ import osqp
 import scipy.sparse as sp
 
 from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.allocation.base import AllocationResult
 from flight_sw.allocation.osqp_lean import LeanOsqp
 from flight_sw.allocation.qp_osqp import (
@@ -104,9 +105,7 @@ from flight_sw.allocation.qp_osqp import (
     check_bound_spec,
     check_demand,
     check_effectiveness,
-    check_positive,
     frozen,
-    is_real,
     monotone_root,
     osqp_settings,
     parse_mask,
@@ -169,20 +168,16 @@ class RobustParams:
     def __post_init__(self) -> None:
         check_bound_spec(_SOURCE, "upper_N", self.upper_N)
         check_bound_spec(_SOURCE, "lower_N", self.lower_N)
-        check_positive(_SOURCE, "rho", self.rho, allow_zero=True)
-        check_positive(_SOURCE, "regularization", self.regularization, allow_zero=True)
+        check.non_negative(_SOURCE, "rho", self.rho)
+        check.non_negative(_SOURCE, "regularization", self.regularization)
         w = self.basis_weights
-        if not (
-            isinstance(w, tuple)
-            and len(w) <= MAX_BASIS_WEIGHTS
-            and all(is_real(x) and math.isfinite(float(x)) for x in w)
-        ):
+        ok = isinstance(w, tuple) and len(w) <= MAX_BASIS_WEIGHTS
+        if ok and w:
+            check.vector(_SOURCE, "basis_weights", w, None)
+        if not ok:
             raise ConfigError(_SOURCE, "basis_weights", w, "a tuple of up to 16 finite numbers")
-        it = self.max_sqp_iter
-        if not (isinstance(it, int) and not isinstance(it, bool) and it >= 1):
-            raise ConfigError(_SOURCE, "max_sqp_iter", it, "an int >= 1")
-        if not isinstance(self.warm_start, bool):
-            raise ConfigError(_SOURCE, "warm_start", self.warm_start, "a bool")
+        check.integer(_SOURCE, "max_sqp_iter", self.max_sqp_iter, 1)
+        check.flag(_SOURCE, "warm_start", self.warm_start)
 
 
 def _upper_pattern(k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -67,16 +67,14 @@ J0 = diag(18, 18, 24) kg m², leader orbit 42,240 km); Filipe & Tsiotras 2015 (J
 from __future__ import annotations
 
 import math
-import numbers
-from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 from mypy_extensions import mypyc_attr
 
-from dbc.errors import ConfigError
 from flight_sw import dual_quaternion as dq
+from flight_sw import validation as check
 from flight_sw.control import anti_unwinding as au
 from flight_sw.quaternion import cross as cross3
 from flight_sw.quaternion import error_quaternion, to_dcm
@@ -99,57 +97,15 @@ DEFAULT_ANTI_UNWINDING_MU = 0.01
 _SOURCE = "NftsmDqParams"
 
 
-def _is_real(value: object) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def three_positive(source: str, key: str, value: object) -> tuple[float, float, float]:
-    """Validate three finite numbers > 0 (a per-axis gain); ConfigError naming ``key``."""
-    expected = "3 finite numbers > 0"
-    if not isinstance(value, Iterable):
-        raise ConfigError(source, key, value, expected)
-    out: list[float] = []
-    for v in value:
-        if not (_is_real(v) and math.isfinite(float(v)) and float(v) > 0.0):
-            raise ConfigError(source, key, value, expected)
-        out.append(float(v))
-    if len(out) != N_AXES:
-        raise ConfigError(source, key, value, expected)
-    return out[0], out[1], out[2]
-
-
-def real_in(source: str, key: str, value: object, lo: float, hi: float, expected: str) -> float:
-    """Validate one number in the open interval (lo, hi) (``inf`` allowed as ``hi``)."""
-    if not (_is_real(value) and lo < float(value) < hi):  # type: ignore[arg-type]
-        raise ConfigError(source, key, value, expected)
-    return float(value)  # type: ignore[arg-type]
-
-
-def validate_limit(source: str, key: str, value: object) -> float:
-    """Validate an output limit: a number > 0, ``inf`` for none."""
-    if not (_is_real(value) and float(value) > 0.0):  # type: ignore[arg-type]
-        raise ConfigError(source, key, value, "a number > 0 (inf: no limit)")
-    return float(value)  # type: ignore[arg-type]
-
-
-def validate_orbit(source: str, mean_motion: object, mu: object) -> tuple[float, float]:
+def validate_orbit(source: str, mean_motion_rad_s: object, mu_m3_s2: object) -> None:
     """Validate the mean motion (finite, ≥ 0) [rad/s] and µ (finite, > 0) [m³/s²]."""
-    if not (_is_real(mean_motion) and 0.0 <= float(mean_motion) < math.inf):  # type: ignore[arg-type]
-        raise ConfigError(source, "mean_motion_rad_s", mean_motion, "a finite number >= 0")
-    mu_f = real_in(source, "mu_m3_s2", mu, 0.0, math.inf, "a finite number > 0")
-    return float(mean_motion), mu_f  # type: ignore[arg-type]
+    check.non_negative(source, "mean_motion_rad_s", mean_motion_rad_s, unit="rad/s")
+    check.positive(source, "mu_m3_s2", mu_m3_s2, unit="m^3/s^2")
 
 
 def validate_inertia(inertia: object) -> np.ndarray:
     """A 3×3 symmetric positive-definite inertia [kg m²] (or 3 principal moments)."""
-    arr = np.asarray(inertia, dtype=float)
-    if arr.shape == (N_AXES,):
-        arr = np.diag(arr)
-    if arr.shape != (N_AXES, N_AXES) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"inertia_B_kgm2 = {inertia!r}: expected a finite 3×3 matrix")
-    if not np.allclose(arr, arr.T) or np.linalg.eigvalsh(arr).min() <= 0.0:
-        raise ValueError(f"inertia_B_kgm2 = {inertia!r}: expected symmetric positive-definite")
-    return arr
+    return check.inertia("PoseController", "inertia_B_kgm2", inertia)
 
 
 def sig(x: np.ndarray, power: float) -> np.ndarray:
@@ -492,11 +448,9 @@ class NftsmDqParams:
 
     def __post_init__(self) -> None:
         s = _SOURCE
-        real_in(s, "mass_kg", self.mass_kg, 0.0, math.inf, "a finite number > 0")
-        object.__setattr__(
-            self, "inertia_B_kgm2", three_positive(s, "inertia_B_kgm2", self.inertia_B_kgm2)
-        )
+        check.positive(s, "mass_kg", self.mass_kg, unit="kg")
         for key in (
+            "inertia_B_kgm2",
             "alpha1_att",
             "alpha1_pos",
             "alpha2_att",
@@ -506,16 +460,16 @@ class NftsmDqParams:
             "k_att_Nm",
             "k_pos_N",
         ):
-            object.__setattr__(self, key, three_positive(s, key, getattr(self, key)))
-        real_in(s, "p1", self.p1, 0.5, 1.0, "a number in (0.5, 1)")
-        real_in(s, "p2", self.p2, 0.0, 1.0, "a number in (0, 1)")
+            object.__setattr__(self, key, check.triple(s, key, getattr(self, key), 0.0,
+                                                        lo_open=True))
+        check.number(s, "p1", self.p1, 0.5, 1.0, lo_open=True, hi_open=True)
+        check.number(s, "p2", self.p2, 0.0, 1.0, lo_open=True, hi_open=True)
         for key in ("delta_att", "delta_pos", "switching_width", "anti_unwinding_mu"):
-            real_in(s, key, getattr(self, key), 0.0, math.inf, "a finite number > 0")
+            check.positive(s, key, getattr(self, key))
         validate_orbit(s, self.mean_motion_rad_s, self.mu_m3_s2)
-        if not isinstance(self.anti_unwinding, bool):
-            raise ConfigError(s, "anti_unwinding", self.anti_unwinding, "true or false")
-        validate_limit(s, "max_force_N", self.max_force_N)
-        validate_limit(s, "max_torque_Nm", self.max_torque_Nm)
+        check.flag(s, "anti_unwinding", self.anti_unwinding)
+        check.limit(s, "max_force_N", self.max_force_N, unit="N")
+        check.limit(s, "max_torque_Nm", self.max_torque_Nm, unit="N m")
 
 
 def _dual_gain(att: tuple[float, float, float], pos: tuple[float, float, float]) -> np.ndarray:

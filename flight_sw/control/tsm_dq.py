@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.control.nftsm_dq import (
     DEFAULT_ANTI_UNWINDING_MU,
     DEFAULT_SWITCHING_WIDTH,
@@ -42,13 +42,10 @@ from flight_sw.control.nftsm_dq import (
     attitude_state,
     clip_norm,
     drift_wrench,
-    real_in,
     relative_motion,
     robust_wrench,
     sig,
-    three_positive,
     validate_inertia,
-    validate_limit,
     validate_orbit,
 )
 
@@ -87,7 +84,7 @@ class TsmDqParams:
 
     def __post_init__(self) -> None:
         s = _SOURCE
-        real_in(s, "mass_kg", self.mass_kg, 0.0, math.inf, "a finite number > 0")
+        check.positive(s, "mass_kg", self.mass_kg, unit="kg")
         for key in (
             "inertia_B_kgm2",
             "b_att",
@@ -97,16 +94,16 @@ class TsmDqParams:
             "k_att_Nm",
             "k_pos_N",
         ):
-            object.__setattr__(self, key, three_positive(s, key, getattr(self, key)))
-        real_in(s, "alpha", self.alpha, 0.5, 1.0, "a number in (0.5, 1)")
-        real_in(s, "p2", self.p2, 0.0, 1.0, "a number in (0, 1)")
+            object.__setattr__(self, key, check.triple(s, key, getattr(self, key), 0.0,
+                                                        lo_open=True))
+        check.number(s, "alpha", self.alpha, 0.5, 1.0, lo_open=True, hi_open=True)
+        check.number(s, "p2", self.p2, 0.0, 1.0, lo_open=True, hi_open=True)
         for key in ("switching_width", "anti_unwinding_mu"):
-            real_in(s, key, getattr(self, key), 0.0, math.inf, "a finite number > 0")
+            check.positive(s, key, getattr(self, key))
         validate_orbit(s, self.mean_motion_rad_s, self.mu_m3_s2)
-        if not isinstance(self.anti_unwinding, bool):
-            raise ConfigError(s, "anti_unwinding", self.anti_unwinding, "true or false")
-        validate_limit(s, "max_force_N", self.max_force_N)
-        validate_limit(s, "max_torque_Nm", self.max_torque_Nm)
+        check.flag(s, "anti_unwinding", self.anti_unwinding)
+        check.limit(s, "max_force_N", self.max_force_N, unit="N")
+        check.limit(s, "max_torque_Nm", self.max_torque_Nm, unit="N m")
 
 
 class TsmDq:

@@ -69,13 +69,12 @@ equal to round-off.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.estimation import rls_kernel as kernel
 from flight_sw.quaternion import skew
 
@@ -84,8 +83,6 @@ N_AXES = 3
 NS_PER_S = 1_000_000_000
 # (row, column) of each entry of θ = (J11, J12, J13, J22, J23, J33)
 THETA_INDEX = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
-# Relative asymmetry tolerated in a configured inertia guess.
-SYMMETRY_RTOL = 1e-9
 TRAPEZOID_WEIGHT = 0.5
 
 DEFAULT_FORGETTING_FACTOR = 0.999  # memory ≈ 1/(1 − λ) = 1000 cycles (20 s at 50 Hz)
@@ -95,15 +92,6 @@ DEFAULT_MIN_REGRESSOR_NORM = 0.0  # [rad/s²]: 0 = every step is used
 DEFAULT_MAX_GAP_S = 1.0  # a longer gap between samples restarts the differencing
 
 _SOURCE = "RlsInertiaParams"
-
-
-def _real(key: str, value: object, expected: str) -> float:
-    if not (isinstance(value, numbers.Real) and not isinstance(value, bool)):
-        raise ConfigError(_SOURCE, key, value, expected)
-    x = float(value)
-    if not math.isfinite(x):
-        raise ConfigError(_SOURCE, key, value, expected)
-    return x
 
 
 def inertia_matrix(theta: np.ndarray) -> np.ndarray:
@@ -212,19 +200,7 @@ class _Window:
 
 
 def _inertia_tuple(value: object) -> tuple[tuple[float, float, float], ...]:
-    expected = "a symmetric positive-definite 3×3 matrix of finite numbers [kg m²]"
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected) from None
-    if arr.shape != (N_AXES, N_AXES) or not np.all(np.isfinite(arr)):
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
-    scale = float(np.max(np.abs(arr)))
-    if not np.allclose(arr, arr.T, rtol=0.0, atol=SYMMETRY_RTOL * scale):
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
-    sym = 0.5 * (arr + arr.T)
-    if not float(np.linalg.eigvalsh(sym)[0]) > 0.0:
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
+    sym = check.inertia(_SOURCE, "inertia_guess_B_kgm2", value)
     return tuple((float(r[0]), float(r[1]), float(r[2])) for r in sym)
 
 
@@ -254,23 +230,13 @@ class RlsInertiaParams:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia_guess_B_kgm2", _inertia_tuple(self.inertia_guess_B_kgm2))
-        lam = _real("forgetting_factor", self.forgetting_factor, "a number in (0, 1]")
-        if not 0.0 < lam <= 1.0:
-            raise ConfigError(_SOURCE, "forgetting_factor", self.forgetting_factor, "in (0, 1]")
-        alpha = _real("initial_covariance", self.initial_covariance, "a finite number > 0")
-        if alpha <= 0.0:
-            raise ConfigError(
-                _SOURCE, "initial_covariance", self.initial_covariance, "a finite number > 0"
-            )
-        for key in ("min_information", "min_regressor_norm"):
-            value = getattr(self, key)
-            if _real(key, value, "a finite number >= 0") < 0.0:
-                raise ConfigError(_SOURCE, key, value, "a finite number >= 0")
-        if _real("max_gap_s", self.max_gap_s, "a finite number > 0 [s]") <= 0.0:
-            raise ConfigError(_SOURCE, "max_gap_s", self.max_gap_s, "a finite number > 0 [s]")
-        w = self.window_cycles
-        if isinstance(w, bool) or not isinstance(w, int) or w < 1:
-            raise ConfigError(_SOURCE, "window_cycles", w, "an integer >= 1")
+        s = _SOURCE
+        check.number(s, "forgetting_factor", self.forgetting_factor, 0.0, 1.0, lo_open=True)
+        check.positive(s, "initial_covariance", self.initial_covariance)
+        check.non_negative(s, "min_information", self.min_information)
+        check.non_negative(s, "min_regressor_norm", self.min_regressor_norm)
+        check.positive(s, "max_gap_s", self.max_gap_s, unit="s")
+        check.integer(s, "window_cycles", self.window_cycles, 1)
 
 
 class RlsInertiaIdentifier:

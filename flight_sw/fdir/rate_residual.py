@@ -72,7 +72,6 @@ equation and ``r × F``: Wie 2008, "Space Vehicle Dynamics and Control", 2nd ed.
 from __future__ import annotations
 
 import math
-import numbers
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -80,6 +79,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.fdir.base import (
     NOTHING,
     FailureKind,
@@ -98,17 +98,6 @@ HISTORY_MARGIN = 6
 MIN_WINDOW_FRACTION = 0.75
 
 _SOURCE = "RateResidualParams"
-
-
-def _positive(key: str, value: object, allow_zero: bool = False) -> None:
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
-    if not ok or value < 0.0 or (value == 0.0 and not allow_zero):  # type: ignore[operator]
-        raise ConfigError(_SOURCE, key, value, f"a finite number {'>=' if allow_zero else '>'} 0")
-
-
-def _count(key: str, value: object) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        raise ConfigError(_SOURCE, key, value, "an integer >= 1")
 
 
 @dataclass(frozen=True)
@@ -159,34 +148,19 @@ class RateResidualParams:
     use_accel: bool = True
 
     def __post_init__(self) -> None:
-        _positive("window_s", self.window_s)
-        _positive("threshold", self.threshold)
-        _positive("glr_threshold", self.glr_threshold)
-        _count("persistence_cycles", self.persistence_cycles)
-        _count("isolation_cycles", self.isolation_cycles)
-        _positive("explained_fraction", self.explained_fraction)
-        _positive("isolation_margin", self.isolation_margin, allow_zero=True)
-        if self.explained_fraction > 1.0:
-            raise ConfigError(
-                _SOURCE, "explained_fraction", self.explained_fraction, "a number in (0, 1]"
-            )
-        for key in (
-            "command_delay_s",
-            "valve_open_delay_s",
-            "valve_close_delay_s",
-            "valve_rise_tau_s",
-            "valve_tail_tau_s",
-        ):
-            _positive(key, getattr(self, key), allow_zero=True)
-        _positive("edge_uncertainty_s", self.edge_uncertainty_s, allow_zero=True)
-        _positive("gyro_noise_rad_s", self.gyro_noise_rad_s)
-        _positive("accel_noise_m_s2", self.accel_noise_m_s2)
-        _positive("accel_bias_m_s2", self.accel_bias_m_s2, allow_zero=True)
-        _positive("model_rel_error", self.model_rel_error, allow_zero=True)
-        _positive("thrust_rel_error", self.thrust_rel_error, allow_zero=True)
-        _positive("bias_time_constant_s", self.bias_time_constant_s)
-        if not isinstance(self.use_accel, bool):
-            raise ConfigError(_SOURCE, "use_accel", self.use_accel, "a bool")
+        s = _SOURCE
+        for key in ("window_s", "threshold", "glr_threshold", "gyro_noise_rad_s",
+                    "accel_noise_m_s2", "bias_time_constant_s"):
+            check.positive(s, key, getattr(self, key))
+        for key in ("isolation_margin", "command_delay_s", "valve_open_delay_s",
+                    "valve_close_delay_s", "valve_rise_tau_s", "valve_tail_tau_s",
+                    "edge_uncertainty_s", "accel_bias_m_s2", "model_rel_error",
+                    "thrust_rel_error"):
+            check.non_negative(s, key, getattr(self, key))
+        for key in ("persistence_cycles", "isolation_cycles"):
+            check.integer(s, key, getattr(self, key), 1)
+        check.number(s, "explained_fraction", self.explained_fraction, 0.0, 1.0, lo_open=True)
+        check.flag(s, "use_accel", self.use_accel)
 
 
 @dataclass(frozen=True)

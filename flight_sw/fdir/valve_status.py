@@ -46,7 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.fdir.base import (
     NOTHING,
     FailureKind,
@@ -56,11 +56,6 @@ from flight_sw.fdir.base import (
 )
 
 _SOURCE = "ValveStatusParams"
-
-
-def _int_at_least(key: str, value: object, lo: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < lo:
-        raise ConfigError(_SOURCE, key, value, f"an integer >= {lo}")
 
 
 @dataclass(frozen=True)
@@ -80,10 +75,9 @@ class ValveStatusParams:
     quiet_cycles: int = 2
 
     def __post_init__(self) -> None:
-        _int_at_least("stuck_closed_samples", self.stuck_closed_samples, 1)
-        _int_at_least("window_samples", self.window_samples, 1)
-        _int_at_least("stuck_open_samples", self.stuck_open_samples, 1)
-        _int_at_least("quiet_cycles", self.quiet_cycles, 1)
+        for key in ("stuck_closed_samples", "window_samples", "stuck_open_samples",
+                    "quiet_cycles"):
+            check.integer(_SOURCE, key, getattr(self, key), 1)
 
 
 class ValveStatusFdir(ThrusterFdirStrategy):
@@ -92,8 +86,7 @@ class ValveStatusFdir(ThrusterFdirStrategy):
     name = "valve_status"
 
     def __init__(self, n_thrusters: int, params: ValveStatusParams) -> None:
-        if n_thrusters < 1:
-            raise ConfigError(_SOURCE, "n_thrusters", n_thrusters, "an integer >= 1")
+        check.integer("ValveStatusFdir", "n_thrusters", n_thrusters, 1)
         self.params = params
         self.n = n_thrusters
         self.reset()

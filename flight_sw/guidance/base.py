@@ -24,14 +24,17 @@ from typing import Protocol
 
 import numpy as np
 
+from flight_sw import validation as check
+
 QUATERNION_SIZE = 4
 VECTOR_SIZE = 3
 
+_SOURCE = "AttitudeReference"
+
 
 def _frozen(name: str, value: object, size: int) -> np.ndarray:
-    arr = np.array(value, dtype=float)
-    if arr.shape != (size,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} = {value!r}: expected {size} finite numbers")
+    """``value`` as a read-only float array of ``size`` finite numbers (ConfigError else)."""
+    arr = np.array(check.vector(_SOURCE, name, value, size))
     arr.setflags(write=False)
     return arr
 

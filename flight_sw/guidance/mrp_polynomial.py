@@ -40,17 +40,18 @@ MRP ↔ quaternion relations and ``ω = 4/(1 + σ²)² Bᵀ σ̇``.
 
 from __future__ import annotations
 
-import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.guidance.base import VECTOR_SIZE, AttitudeReference
 from flight_sw.quaternion import skew
 
 NS_PER_S = 1_000_000_000
+_SOURCE = "MrpPolynomialGuidance"
 # Kinematics constants (ω = OMEGA_GAIN/(1 + s)² Bᵀ σ̇; B = (1 − s) I + 2[σ×] + 2σσᵀ).
 OMEGA_GAIN = 4.0
 B_CROSS = 2.0
@@ -114,22 +115,12 @@ def mrp_omega_dot(sigma: np.ndarray, sigma_dot: np.ndarray, sigma_ddot: np.ndarr
 
 
 def _coeffs(value: object) -> tuple[tuple[float, ...], ...]:
-    expected = "3 non-empty lists of finite numbers (ascending powers of t [s])"
-    if not isinstance(value, Sequence) or isinstance(value, str) or len(value) != VECTOR_SIZE:
-        raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-    out: list[tuple[float, ...]] = []
-    for axis in value:
-        if not isinstance(axis, Sequence) or isinstance(axis, str) or len(axis) == 0:
-            raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-        row: list[float] = []
-        for c in axis:
-            if not (isinstance(c, numbers.Real) and not isinstance(c, bool)):
-                raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-            if not math.isfinite(float(c)):
-                raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-            row.append(float(c))
-        out.append(tuple(row))
-    return tuple(out)
+    """Three non-empty lists of finite coefficients (ConfigError naming ``sigma_coeffs``)."""
+    items = list(value) if isinstance(value, Sequence) and not isinstance(value, str) else []
+    if len(items) != VECTOR_SIZE:
+        raise ConfigError(_SOURCE, "sigma_coeffs", value,
+                          "3 non-empty lists of finite numbers (ascending powers of t [s])")
+    return tuple(check.vector(_SOURCE, "sigma_coeffs", axis, None) for axis in items)
 
 
 def _derivative(coeffs: tuple[float, ...]) -> tuple[float, ...]:
@@ -166,11 +157,8 @@ class MrpPolynomialGuidance:
 
     def __post_init__(self) -> None:
         coeffs = _coeffs(self.sigma_coeffs)
-        if not (isinstance(self.t0_ns, numbers.Integral) and not isinstance(self.t0_ns, bool)):
-            raise ValueError(f"t0_ns = {self.t0_ns!r}: expected an integer [ns]")
-        d = self.duration_s
-        if not (isinstance(d, numbers.Real) and not isinstance(d, bool) and d > 0.0):
-            raise ValueError(f"duration_s = {d!r}: expected a number > 0 [s] (inf allowed)")
+        check.integer(_SOURCE, "t0_ns", self.t0_ns)
+        check.limit(_SOURCE, "duration_s", self.duration_s, unit="s")
         d1 = tuple(_derivative(c) for c in coeffs)
         object.__setattr__(self, "sigma_coeffs", coeffs)
         object.__setattr__(self, "_c", coeffs)
