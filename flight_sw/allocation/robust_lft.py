@@ -25,10 +25,10 @@ function) with ``φ'(τ) = ∂f/∂τ`` at the inner minimiser ``T(τ)`` (Danski
 
 1. inner problem (τ fixed): the box QP ``min TᵀM T − 2cᵀT`` with
    ``M = CᵀDC + HᵀH/τ + εI``, ``c = CᵀD Uᵀv``, ``C = UᵀB₀``, ``D = diag(1/(1 − τ sⱼ))``,
-   solved exactly by the dense active-set :func:`~flight_sw.allocation.qp_osqp.box_qp`,
+   solved exactly by the dense active-set :func:`~flight_sw.allocation.active_set.box_qp`,
    warm-started from the previous active set;
 2. outer problem: ``φ'(τ) = 0`` on ``θ = τ·max s ∈ [THETA_MIN, LFT_THETA_MAX]`` by
-   safeguarded Newton (:func:`~flight_sw.allocation.qp_osqp.monotone_root`; ``φ''`` from
+   safeguarded Newton (:func:`~flight_sw.allocation.root_finding.monotone_root`; ``φ''`` from
    the sensitivity of ``T`` on its active set: ``f_ττ − 2 wᵀ M_FF⁻¹ w``), started from the
    previous allocation's θ (cold: :data:`LFT_THETA_START`). It stops when the Newton
    decrement ``φ'²/φ''`` (≈ ``φ(τ) − min φ``) is below :data:`LFT_RTOL` × ``f`` — a global
@@ -72,26 +72,10 @@ import numpy as np
 
 from dbc.errors import ConfigError
 from flight_sw import validation as check
-from flight_sw.allocation.base import AllocationResult
-from flight_sw.allocation.qp_osqp import (
-    ACTIVE_RTOL,
-    DEFAULT_REGULARIZATION,
-    FREE,
-    REFINE_RTOL,
-    BoundSpec,
-    attained_tolerance,
-    box_qp,
-    check_bound_spec,
-    check_demand,
-    check_effectiveness,
-    frozen,
-    monotone_root,
-    parse_mask,
-    range_basis_T,
-    refine_on_active_set,
-    thrust_bounds,
-    trivial_result,
-)
+from flight_sw.allocation.active_set import FREE, bound_active, box_qp, refine
+from flight_sw.allocation.base import BoundSpec, ControlAllocation, check_bound_spec, frozen
+from flight_sw.allocation.qp_osqp import DEFAULT_REGULARIZATION
+from flight_sw.allocation.root_finding import monotone_root
 from flight_sw.allocation.uncertainty import (
     EIG_RTOL,
     SEED001_RHO,
@@ -154,8 +138,10 @@ class RobustLftParams:
         check.flag(_SOURCE, "warm_start", self.warm_start)
 
 
-class RobustLftAllocator:
-    """Exact worst-case least squares under ``ΔB = E F H``, ``‖F‖ ≤ 1`` (an ``Allocator``)."""
+class RobustLftAllocator(ControlAllocation):
+    """Exact worst-case least squares under ``ΔB = E F H``, ``‖F‖ ≤ 1`` (seed 001, Thm 3)."""
+
+    _source = "RobustLftAllocator"
 
     def __init__(
         self,
@@ -163,10 +149,10 @@ class RobustLftAllocator:
         params: RobustLftParams,
         mask: Sequence[bool] | np.ndarray | None = None,
     ) -> None:
-        src = "RobustLftAllocator"
-        b = check_effectiveness(src, effectiveness)
+        super().__init__(effectiveness, params, mask, params.lower_N, params.upper_N)
+        src = self._source
+        b = self._b
         m, n = b.shape
-        lo, hi = thrust_bounds(src, params.lower_N, params.upper_N, n)
         e_shape = np.eye(m) if params.e_shape is None else np.array(params.e_shape, dtype=float)
         if e_shape.shape[0] != m:
             raise ConfigError(src, "e_shape", e_shape.shape, f"{m} rows")
@@ -176,26 +162,17 @@ class RobustLftAllocator:
             h_full = np.array(params.h_matrix, dtype=float)
             if h_full.shape[1] != n:
                 raise ConfigError(src, "h_matrix", h_full.shape, f"{n} columns")
-        self._b = b
-        self._params = params
         self._e = frozen(params.rho * e_shape)
         self._h = frozen(h_full)
-        self._mask = parse_mask(src, mask, n)
-        self._avail = np.flatnonzero(self._mask)
-        self._lo, self._hi = frozen(lo), frozen(hi)
-        self._lo_a, self._hi_a = lo[self._avail], hi[self._avail]
-        b_a = b[:, self._avail]
+        b_a = self._b_a
         h_a = h_full[:, self._avail]
-        self._b_a, self._h_a = b_a, h_a
-        self._range_T = range_basis_T(b_a)
-        self._attained_tol = attained_tolerance(b_a, self._lo_a, self._hi_a)
+        self._h_a = h_a
         s, u = np.linalg.eigh(self._e @ self._e.T)
         s_max = float(np.max(s)) if s.size else 0.0
         self._eig_s = np.where(s > EIG_RTOL * max(s_max, 0.0), s, 0.0)
         self._eig_u = u
         self._uncertain = s_max > 0.0 and bool(np.any(h_a != 0.0))
         k = self._avail.size
-        self._has_thrusters = k > 0
         self._eps = params.regularization * float(np.mean(np.sum(b_a * b_a, axis=0))) if k else 0.0
         self._definite = self._eps > 0.0
         self._s_max = s_max
@@ -207,36 +184,10 @@ class RobustLftAllocator:
         self._state = np.full(k, FREE, dtype=np.int8)
         self._theta_warm = math.nan
 
-    # --- introspection -----------------------------------------------------------------
-
-    @property
-    def params(self) -> RobustLftParams:
-        """The parameters this allocator was built with."""
-        return self._params
-
-    @property
-    def mask(self) -> np.ndarray:
-        """The availability mask (read-only; True = usable)."""
-        return self._mask
-
-    @property
-    def effectiveness(self) -> np.ndarray:
-        """The nominal m×n effectiveness matrix B₀ (read-only)."""
-        return self._b
-
     @property
     def lft_matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """``(E, H)`` of ``ΔB = E F H`` (read-only; ``E = ρ E_shape``)."""
         return self._e, self._h
-
-    @property
-    def bounds_N(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per-thruster (lower, upper) thrust bounds [N] (read-only)."""
-        return self._lo, self._hi
-
-    def with_mask(self, mask: Sequence[bool] | np.ndarray) -> RobustLftAllocator:
-        """A new allocator for the same thrusters and uncertainty with availability ``mask``."""
-        return RobustLftAllocator(self._b, self._params, mask)
 
     def worst_case_residual(self, thrust_N: np.ndarray, demand: np.ndarray) -> float:
         """``max_{‖F‖≤1} ‖(B₀ + EFH) T − demand‖`` (exact)."""
@@ -257,15 +208,9 @@ class RobustLftAllocator:
         t, self._state = box_qp(
             self._nominal_m, self._b_a.T @ v, self._lo_a, self._hi_a, self._state, self._definite
         )
-        refined = refine_on_active_set(self._b_a, v, t, self._lo_a, self._hi_a)
-        if refined is not None:
-            r_ref, r_t = self._b_a @ refined - v, self._b_a @ t - v
-            limit = float(r_t @ r_t) * (1.0 + REFINE_RTOL) + self._attained_tol**2
-            if float(r_ref @ r_ref) <= limit:
-                return refined
-        return t
+        return refine(self._b_a, v, t, self._lo_a, self._hi_a, self._attained_tol**2)
 
-    def _solve(self, v: np.ndarray) -> np.ndarray:
+    def _robust(self, v: np.ndarray) -> np.ndarray:
         if not self._uncertain:
             return self._nominal(v)
         cv = self._eig_u.T @ v
@@ -308,21 +253,6 @@ class RobustLftAllocator:
         )
         return best[0][1]
 
-    def allocate(self, demand: np.ndarray) -> AllocationResult:
-        """Robust thrusts [N] for the torque/wrench ``demand`` (see the module docstring)."""
-        m, n = self._b.shape
-        d = check_demand(demand, m)
-        if not self._has_thrusters or not np.all(np.isfinite(d)):
-            return trivial_result(d, n)
-        t_a = self._solve(d)
-        thrust = np.zeros(n)
-        thrust[self._avail] = t_a
-        achieved = self._b @ thrust
-        r = d - achieved
-        in_range = self._range_T @ r
-        tol = ACTIVE_RTOL * (self._hi_a - self._lo_a)
-        active = bool(np.any((t_a <= self._lo_a + tol) | (t_a >= self._hi_a - tol)))
-        saturated = active and math.sqrt(float(in_range @ in_range)) > self._attained_tol
-        return AllocationResult(
-            frozen(thrust), frozen(achieved), math.sqrt(float(r @ r)), saturated
-        )
+    def _solve(self, d: np.ndarray) -> tuple[np.ndarray, bool | None]:
+        t_a = self._robust(d)
+        return t_a, None if bound_active(t_a, self._lo_a, self._hi_a) else False

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from flight_sw.allocation import dense
-from flight_sw.allocation.qp_osqp import (
+from flight_sw.allocation.active_set import (
     ACTIVE_RTOL,
     BOX_XTOL,
     FREE,
