@@ -64,6 +64,7 @@ from flight_sw.fdir.rate_residual import RateResidualFdir, RateResidualParams
 from flight_sw.fdir.sensor_watchdog import LOST_AFTER_PERIODS, SensorWatchdog
 from flight_sw.fdir.thruster_fdir import ThrusterFdir
 from flight_sw.fdir.valve_status import ValveStatusFdir, ValveStatusParams
+from flight_sw.fdir.valve_timing import DEFAULT_TIMING, ValveTiming
 from flight_sw.guidance.base import AttitudeGuidance
 from flight_sw.guidance.mrp_polynomial import MrpPolynomialGuidance
 from flight_sw.modulation.base import Modulator
@@ -108,18 +109,38 @@ class Vehicle:
             raise root.error("thrusters", [], "at least one thruster")
         self.r_thr_B_m = np.array([x.vector("r_thr_B_m", 3) for x in thr])
         self.d_thr_B = np.array([x.vector("d_thr_B", 3) for x in thr])
-        self.max_thrust_N = root.number("max_thrust_N", lo=0.0, lo_open=True)
-        # per thruster (optional; e.g. seed 001's opposing pairs of unequal bounds)
+        # one maximum for all, or each thruster its own (e.g. seed 001's opposing valves of
+        # unequal bounds); every consumer gets the per-thruster vector (n,) [N]
+        default_N = root.number("max_thrust_N", lo=0.0, lo_open=True)
         self.max_thrust_each_N = np.array(
-            [x.number("max_thrust_N", self.max_thrust_N, lo=0.0, lo_open=True) for x in thr]
+            [x.number("max_thrust_N", default_N, lo=0.0, lo_open=True) for x in thr]
         )
         for x in thr:
             x.done()
         self.min_on_s = root.number("min_on_s", lo=0.0)
+        self.valve_timing = _valve_timing(root)
         self.effectiveness = effectiveness_matrix(self.r_thr_B_m, self.d_thr_B)
         self.demand_rows = TORQUE_ROWS  # WRENCH_ROWS once a translation controller is set
         self.control_period_ns = 0
         self.imu_period_ns = 0
+
+
+def _valve_timing(root: Table) -> ValveTiming:
+    """The vehicle's valve timing from the optional ``valve_timing`` table (each key
+    optional; defaults: :mod:`flight_sw.fdir.valve_timing`)."""
+    if not root.has("valve_timing"):
+        return DEFAULT_TIMING
+    t = root.table("valve_timing")
+    d = DEFAULT_TIMING
+    timing = ValveTiming(
+        command_delay_s=t.number("command_delay_s", d.command_delay_s, lo=0.0),
+        open_delay_s=t.number("open_delay_s", d.open_delay_s, lo=0.0),
+        close_delay_s=t.number("close_delay_s", d.close_delay_s, lo=0.0),
+        rise_tau_s=t.number("rise_tau_s", d.rise_tau_s, lo=0.0),
+        tail_tau_s=t.number("tail_tau_s", d.tail_tau_s, lo=0.0),
+    )
+    t.done()
+    return timing
 
 
 def _mekf(t: Table, v: Vehicle) -> AttitudeEstimator:
@@ -380,6 +401,7 @@ def _valve_status(t: Table, v: Vehicle) -> ThrusterFdirStrategy:
 
 def _rate_residual(t: Table, v: Vehicle) -> ThrusterFdirStrategy:
     d = RateResidualParams()
+    vt = v.valve_timing  # the vehicle's valve data (defaults: flight_sw.fdir.valve_timing)
     use_accel = t.raw("use_accel", d.use_accel)
     if not isinstance(use_accel, bool):
         raise t.error("use_accel", use_accel, "true or false")
@@ -393,11 +415,11 @@ def _rate_residual(t: Table, v: Vehicle) -> ThrusterFdirStrategy:
             "explained_fraction", d.explained_fraction, lo=0.0, lo_open=True, hi=1.0
         ),
         isolation_margin=t.number("isolation_margin", d.isolation_margin, lo=0.0),
-        command_delay_s=t.number("command_delay_s", d.command_delay_s, lo=0.0),
-        valve_open_delay_s=t.number("valve_open_delay_s", d.valve_open_delay_s, lo=0.0),
-        valve_close_delay_s=t.number("valve_close_delay_s", d.valve_close_delay_s, lo=0.0),
-        valve_rise_tau_s=t.number("valve_rise_tau_s", d.valve_rise_tau_s, lo=0.0),
-        valve_tail_tau_s=t.number("valve_tail_tau_s", d.valve_tail_tau_s, lo=0.0),
+        command_delay_s=t.number("command_delay_s", vt.command_delay_s, lo=0.0),
+        valve_open_delay_s=t.number("valve_open_delay_s", vt.open_delay_s, lo=0.0),
+        valve_close_delay_s=t.number("valve_close_delay_s", vt.close_delay_s, lo=0.0),
+        valve_rise_tau_s=t.number("valve_rise_tau_s", vt.rise_tau_s, lo=0.0),
+        valve_tail_tau_s=t.number("valve_tail_tau_s", vt.tail_tau_s, lo=0.0),
         edge_uncertainty_s=t.number("edge_uncertainty_s", d.edge_uncertainty_s, lo=0.0),
         gyro_noise_rad_s=t.number("gyro_noise_rad_s", d.gyro_noise_rad_s, lo=0.0, lo_open=True),
         accel_noise_m_s2=t.number("accel_noise_m_s2", d.accel_noise_m_s2, lo=0.0, lo_open=True),
@@ -413,7 +435,7 @@ def _rate_residual(t: Table, v: Vehicle) -> ThrusterFdirStrategy:
         v.effectiveness,
         v.inertia_B_kgm2,
         v.mass_kg,
-        v.max_thrust_N,
+        v.max_thrust_each_N,
         v.min_on_s,
         v.control_period_ns,
         v.imu_period_ns,
