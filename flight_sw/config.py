@@ -298,15 +298,14 @@ def _tsm_dq(t: Table, v: Vehicle) -> PoseController:
     return TsmDq(_dataclass_params(t, TsmDqParams, _nominal_mass(v)))
 
 
-def _pseudo_inverse(t: Table, v: Vehicle) -> Allocator:
-    """Seeds 003/000 baseline; one bound for all (the smallest maximum thrust)."""
-    b = v.effectiveness[v.demand_rows]
-    tmax = float(np.min(v.max_thrust_each_N))
-    return PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_N=tmax))
-
-
 def _upper_N(v: Vehicle) -> tuple[float, ...]:
     return tuple(float(x) for x in v.max_thrust_each_N)
+
+
+def _pseudo_inverse(t: Table, v: Vehicle) -> Allocator:
+    """Seeds 003/000 baseline; each thruster bounded by its own maximum thrust."""
+    b = v.effectiveness[v.demand_rows]
+    return PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_N=_upper_N(v)))
 
 
 def _qp_osqp(t: Table, v: Vehicle) -> Allocator:
