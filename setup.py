@@ -5,8 +5,8 @@ What and why
     environment wrenches), disturbance and gravity-gradient models, valves and thruster
     set, CAN bit timing, plant, sensors, the bench loop, recorder; dbc: E2E CRC, signal
     packing, frame encoding and checks; flight_sw: quaternions, dual quaternions, NFTSM,
-    PWPF, the allocators' dense box-QP and least-squares kernels, the RLS identifier's
-    kernel) are plain, fully typed Python. mypyc (mypy's compiler,
+    PWPF, the dense solver (Cholesky, Jacobi SVD) and the allocators' box-QP and
+    least-squares kernels, the RLS identifier's kernel) are plain, fully typed Python. mypyc (mypy's compiler,
     https://mypyc.readthedocs.io) turns each into a C extension that Python imports
     instead of the ``.py`` beside it; the arithmetic is the same IEEE double arithmetic
     in the same order (no fused multiply-add on the x86-64 baseline), so results are
@@ -67,6 +67,7 @@ COMPILED = [
     "flight_sw/modulation/pwpf.py",
     "flight_sw/control/nftsm_dq.py",
     "flight_sw/allocation/dense.py",
+    "flight_sw/allocation/dense_active_set.py",
     "flight_sw/estimation/rls_kernel.py",
 ]
 PURE_ENV = "THRUSTER_HIL_PURE"
