@@ -41,8 +41,9 @@ practice (ECSS-E-ST-70-11C, on-board monitoring with filters).
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -56,6 +57,20 @@ from flight_sw.fdir.base import (
 )
 
 _SOURCE = "ValveStatusParams"
+MAX_THR_STATUS = 16  # THR_STATUS carries thrusters 0..15
+STATUS_CMD = tuple(f"Cmd_T{k:02d}" for k in range(MAX_THR_STATUS))  # its signal names
+STATUS_OPEN = tuple(f"Open_T{k:02d}" for k in range(MAX_THR_STATUS))
+STATUS_CURRENT = tuple(f"Current_T{k:02d}" for k in range(MAX_THR_STATUS))
+
+
+def status_flags(signals: Mapping[str, Any], n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per thruster (the first ``min(n, 16)``): coil commanded, valve open, coil current, as
+    boolean arrays from a decoded THR_STATUS frame (absent signals read as 0)."""
+    k_max = min(n, MAX_THR_STATUS)
+    cmd = np.array([bool(signals.get(STATUS_CMD[k], 0)) for k in range(k_max)])
+    opened = np.array([bool(signals.get(STATUS_OPEN[k], 0)) for k in range(k_max)])
+    current = np.array([bool(signals.get(STATUS_CURRENT[k], 0)) for k in range(k_max)])
+    return cmd, opened, current
 
 
 @dataclass(frozen=True)
