@@ -148,8 +148,8 @@ def least_norm_svd(a: Matrix, b: list[float], rcond: float) -> list[float]:
     sigma_max = 0.0
     for k in range(len(w)):
         s = 0.0
-        for e in w[k]:
-            s += e * e
+        for val in w[k]:
+            s += val * val
         norms2[k] = s
         sigma_max = max(sigma_max, math.sqrt(s))
     x = [0.0] * cols_a
