@@ -73,7 +73,14 @@ import numpy as np
 from dbc.errors import ConfigError
 from flight_sw import validation as check
 from flight_sw.allocation.active_set import FREE, bound_active, box_qp, refine
-from flight_sw.allocation.base import BoundSpec, ControlAllocation, check_bound_spec, frozen
+from flight_sw.allocation.base import (
+    RANK_RTOL,
+    BoundSpec,
+    ControlAllocation,
+    check_bound_spec,
+    frozen,
+)
+from flight_sw.allocation.dense import PD_PIVOT_RTOL, spd_solve
 from flight_sw.allocation.qp_osqp import DEFAULT_REGULARIZATION
 from flight_sw.allocation.root_finding import monotone_root
 from flight_sw.allocation.uncertainty import (
@@ -236,10 +243,9 @@ class RobustLftAllocator(ControlAllocation):
                 w = (
                     self._c_mat.T @ (sd2 * (self._c_mat @ t - cv)) - self._hth @ t / (tau * tau)
                 )[idx]
-                try:
-                    curv -= 2.0 * float(w @ np.linalg.solve(m_mat[np.ix_(idx, idx)], w))
-                except np.linalg.LinAlgError:
-                    curv = math.nan
+                m_ff = m_mat[np.ix_(idx, idx)].tolist()
+                sol = spd_solve(m_ff, list(range(idx.size)), w.tolist(), PD_PIVOT_RTOL, RANK_RTOL)
+                curv -= 2.0 * float(w @ np.array(sol))
             # Newton decrement ψ²/ψ' estimates φ(τ) − min φ; ψ' in θ units below.
             done = curv > 0.0 and psi * psi / curv <= LFT_RTOL * obj + self._attained_tol**2
             return psi / s_max, curv / (s_max * s_max), done

@@ -72,6 +72,7 @@ import scipy.sparse as sp
 
 from flight_sw.allocation.active_set import FREE, box_qp, refine
 from flight_sw.allocation.base import RANK_RTOL
+from flight_sw.allocation.dense import PD_PIVOT_RTOL, spd_solve
 from flight_sw.allocation.osqp_lean import LeanOsqp, osqp_settings
 from flight_sw.allocation.root_finding import monotone_root
 
@@ -228,16 +229,13 @@ class VertexMinimaxSolver:
             if idx.size and not done:
                 a = (1.0 - lam) * s1 * s1 + lam * s2 * s2
                 rhs = ((s2 - s1) * rv - (s2 * s2 - s1 * s1) * (gram @ t))[idx]
-                try:
-                    m_ff = a * gram[np.ix_(idx, idx)] + eps * eye[: idx.size, : idx.size]
-                    dt = np.linalg.solve(m_ff, rhs)
-                except np.linalg.LinAlgError:
-                    dt = None
-                if dt is not None:
-                    dy = ref[:, idx] @ dt
-                    y = ref @ t
-                    dh = (s2 - s1) * (2.0 * (s1 + s2) * float(y @ dy) - 2.0 * float(v @ dy))
-                    dpsi = -dh
+                m_ff = a * gram[np.ix_(idx, idx)] + eps * eye[: idx.size, : idx.size]
+                dt = np.array(spd_solve(m_ff.tolist(), list(range(idx.size)), rhs.tolist(),
+                                        PD_PIVOT_RTOL, RANK_RTOL))
+                dy = ref[:, idx] @ dt
+                y = ref @ t
+                dh = (s2 - s1) * (2.0 * (s1 + s2) * float(y @ dy) - 2.0 * float(v @ dy))
+                dpsi = -dh
             return -h, dpsi, done
 
         # Cold start: λ = s₁/(s₁ + s₂), the optimum when the demand stays attainable.
