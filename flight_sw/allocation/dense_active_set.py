@@ -95,7 +95,21 @@ def box_qp_pdas(m: Matrix, c: list[float], lo: list[float], hi: list[float],
                 x[i] = 0.0
             else:
                 x[i] = lo[i] if s_i == AT_LOWER else hi[i]
-        x = _free_solve(m, c, x, free, definite, rcond)
+        if free:  # M_FF x_F = c_F − M_FA x_A (written out: the per-cycle hot path)
+            rhs: list[float] = []
+            for i in free:
+                row = m[i]
+                s = c[i]
+                for j in range(n):
+                    if st[j] != FREE:
+                        s -= row[j] * x[j]
+                rhs.append(s)
+            if definite:
+                sol = spd_solve(m, free, rhs, PD_PIVOT_RTOL, rcond)
+            else:
+                sol = least_norm_svd([[m[i][j] for j in free] for i in free], rhs, rcond)
+            for k in range(len(free)):
+                x[free[k]] = sol[k]
         new = [FREE] * n
         for i in range(n):
             if lo[i] >= hi[i]:
