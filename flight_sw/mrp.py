@@ -13,7 +13,7 @@ Formulas (``s = σᵀσ``, ``[σ×]`` the cross-product matrix):
 - ``Ḟ(σ, σ̇) = ½ [−(σᵀσ̇) I + [σ̇×] + σ̇σᵀ + σσ̇ᵀ]`` (term-by-term derivative of ``F``);
 - the body rate of an MRP trajectory ``ω = F⁻¹(σ) σ̇`` (:func:`rate_to_omega`) and its
   derivative ``ω̇ = Ġ σ̇ + G σ̈`` with ``Ġ = 16/(1 + s)² Ḟᵀ − 2ṡ/(1 + s) G``,
-  ``ṡ = 2σᵀσ̇`` (:func:`omega_dot`; product rule on ``G = 16/(1 + s)² Fᵀ``).
+  ``ṡ = 2σᵀσ̇`` (:func:`omega_and_rate`; product rule on ``G = 16/(1 + s)² Fᵀ``).
 
 Conventions: a quaternion ``q_BN`` (maps N to B, see :mod:`flight_sw.quaternion`) gives
 ``σ_BN`` with ``σ̇_BN = F(σ_BN) ω_BN_B`` (ω in body axes [rad/s]); the DCM is the
@@ -109,8 +109,10 @@ def rate_to_omega(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
     return kinematics_matrix_inverse(sigma) @ np.asarray(sigma_dot, dtype=float)
 
 
-def omega_dot(sigma: np.ndarray, sigma_dot: np.ndarray, sigma_ddot: np.ndarray) -> np.ndarray:
-    """``ω̇ = Ġ σ̇ + G σ̈`` [rad/s²], the derivative of :func:`rate_to_omega` (module docstring)."""
+def omega_and_rate(sigma: np.ndarray, sigma_dot: np.ndarray, sigma_ddot: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """``(ω, ω̇)`` of an MRP trajectory: :func:`rate_to_omega` and its derivative
+    ``ω̇ = Ġ σ̇ + G σ̈`` [rad/s²] (module docstring), sharing ``G = F⁻¹(σ)``."""
     s = np.asarray(sigma, dtype=float)
     sd = np.asarray(sigma_dot, dtype=float)
     sdd = np.asarray(sigma_ddot, dtype=float)
@@ -119,4 +121,4 @@ def omega_dot(sigma: np.ndarray, sigma_dot: np.ndarray, sigma_ddot: np.ndarray) 
     g = kinematics_matrix_inverse(s)
     g_dot = (INVERSE_SCALE / (1.0 + norm_sq) ** 2 * kinematics_matrix_rate(s, sd).T
              - 2.0 * s_dot / (1.0 + norm_sq) * g)
-    return g_dot @ sd + g @ sdd
+    return g @ sd, g_dot @ sd + g @ sdd

@@ -24,6 +24,7 @@ from typing import Protocol
 
 import numpy as np
 
+from dbc.errors import ConfigError
 from flight_sw import validation as check
 
 QUATERNION_SIZE = 4
@@ -33,8 +34,18 @@ _SOURCE = "AttitudeReference"
 
 
 def _frozen(name: str, value: object, size: int) -> np.ndarray:
-    """``value`` as a read-only float array of ``size`` finite numbers (ConfigError else)."""
-    arr = np.array(check.vector(_SOURCE, name, value, size))
+    """``value`` as a read-only float array of ``size`` finite numbers (ConfigError else).
+
+    The array test runs first (every cycle builds a reference); the validator only words
+    the error.
+    """
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.zeros(0)
+    if arr.shape != (size,) or not np.all(np.isfinite(arr)):
+        check.vector(_SOURCE, name, value, size)  # raises, naming the field
+        raise ConfigError(_SOURCE, name, value, f"{size} finite numbers")  # e.g. a bool
     arr.setflags(write=False)
     return arr
 

@@ -126,6 +126,5 @@ class MrpPolynomialGuidance:
         sig = self.sigma(tau_s)
         sd = np.array([_polyval(c, tau_s) for c in self._d1])
         sdd = np.array([_polyval(c, tau_s) for c in self._d2])
-        return AttitudeReference(
-            mrp.to_quaternion(sig), mrp.rate_to_omega(sig, sd), mrp.omega_dot(sig, sd, sdd)
-        )
+        omega, omega_dot = mrp.omega_and_rate(sig, sd, sdd)
+        return AttitudeReference(mrp.to_quaternion(sig), omega, omega_dot)
