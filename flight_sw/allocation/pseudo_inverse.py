@@ -267,7 +267,8 @@ class PseudoInverseAllocator(ControlAllocation):
                     if self._in_range_residual(d, candidate) <= self._attained_tol:
                         repaired = candidate
                 if repaired is None:
-                    t_a *= float(np.min(u_a[over] / t_a[over]))
+                    # min over the overflowing thrusters of T_max,i/T_i (the others give ≥ it)
+                    t_a *= float((u_a / np.maximum(t_a, u_a)).min())
                     saturated = True
                 else:
                     t_a = repaired
