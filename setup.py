@@ -4,14 +4,15 @@ What and why
     The modules in :data:`COMPILED` (bench: rigid-body RK4 (also with HCW translation and
     environment wrenches), disturbance and gravity-gradient models, valves and thruster
     set, CAN bit timing, plant, sensors, the bench loop, recorder; dbc: E2E CRC, signal
-    packing, frame encoding and checks; flight_sw: quaternions, dual quaternions, NFTSM,
-    PWPF, the allocators' dense box-QP and least-squares kernels, the RLS identifier's
-    kernel) are plain, fully typed Python. mypyc (mypy's compiler,
-    https://mypyc.readthedocs.io) turns each into a C extension that Python imports
-    instead of the ``.py`` beside it; the arithmetic is the same IEEE double arithmetic
-    in the same order (no fused multiply-add on the x86-64 baseline), so results are
-    bit-identical (``tests/test_compiled.py`` checks compiled against the source on known
-    inputs). ``benchmarks/compiled_speedup.py`` measures the gain.
+    packing, frame encoding and checks; flight_sw: 3-vector algebra, quaternions, dual
+    quaternions, the pose laws' error state, NFTSM and TSM, the anti-unwinding error,
+    PWPF, the dense solver (Cholesky, Jacobi SVD) and the allocators' box-QP and
+    least-squares kernels, the RLS identifier's kernel) are plain, fully typed Python.
+    mypyc (mypy's compiler, https://mypyc.readthedocs.io) turns each into a C extension
+    that Python imports instead of the ``.py`` beside it; the arithmetic is the same IEEE
+    double arithmetic in the same order (no fused multiply-add on the x86-64 baseline), so
+    results are bit-identical (``tests/test_compiled.py`` checks compiled against the
+    source on known inputs). ``benchmarks/compiled_speedup.py`` measures the gain.
 
 Pure-Python install
     ``THRUSTER_HIL_PURE=1 pip install -e .`` builds nothing: every module runs from its
@@ -80,11 +81,16 @@ COMPILED = [
     "bench/results/fsw_view.py",
     "bench/wire/trace.py",
     "bench/results/writers.py",
+    "flight_sw/vec3.py",
     "flight_sw/quaternion.py",
     "flight_sw/dual_quaternion.py",
     "flight_sw/modulation/pwpf.py",
+    "flight_sw/control/anti_unwinding.py",
+    "flight_sw/control/dq_error_state.py",
     "flight_sw/control/nftsm_dq.py",
+    "flight_sw/control/tsm_dq.py",
     "flight_sw/allocation/dense.py",
+    "flight_sw/allocation/dense_active_set.py",
     "flight_sw/estimation/rls_kernel.py",
 ]
 PURE_ENV = "THRUSTER_HIL_PURE"

@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from flight_sw import validation as check
 from flight_sw.allocation.base import Allocator
 from flight_sw.control.base import (
     AttitudeController,
@@ -52,9 +53,10 @@ from flight_sw.fdir.base import ThrusterFailure
 from flight_sw.fdir.frozen_sensor import FrozenSensorMonitor
 from flight_sw.fdir.sensor_watchdog import SensorWatchdog
 from flight_sw.fdir.thruster_fdir import FdirReport, ThrusterFdir
+from flight_sw.fdir.valve_status import status_flags
 from flight_sw.modes import FdirFlag, Mode, SensorFlag
 from flight_sw.modulation.base import Modulator
-from flight_sw.quaternion import to_dcm
+from flight_sw.reference import References, Timeline
 
 if TYPE_CHECKING:
     from flight_sw.guidance.base import AttitudeGuidance
@@ -63,10 +65,6 @@ NS_PER_S = 1_000_000_000
 TORQUE_DIM = 3
 WRENCH_DIM = 6
 ZERO3 = (0.0, 0.0, 0.0)
-MAX_THR_STATUS = 16  # THR_STATUS carries thrusters 0..15
-STATUS_CMD = tuple(f"Cmd_T{k:02d}" for k in range(MAX_THR_STATUS))  # its signal names
-STATUS_OPEN = tuple(f"Open_T{k:02d}" for k in range(MAX_THR_STATUS))
-STATUS_CURRENT = tuple(f"Current_T{k:02d}" for k in range(MAX_THR_STATUS))
 DEFAULT_NAV_TIMEOUT_NS = 300_000_000  # 3 NAV_POS periods of 100 ms
 # realtime: the cycle 2 ms after the bench's control instant (its samples of that instant
 # have arrived; lockstep models the same answer 1 ms after SYNC)
@@ -89,20 +87,12 @@ class CycleResult:
     fdir: FdirReport | None = None
     residual_force_N: float = 0.0  # force part (6-DoF allocation) [N]
 
-
-@dataclass
-class Timeline:
-    """The manoeuvre: hold until ``t_start_ns``, then point at ``q_target_BN``.
-
-    Times are relative to ``time_base_ns`` (the flight-software time of the bench's time 0:
-    0 in lockstep, where the flight software runs on the bench's time). ``r_target_N_m``:
-    the position to hold in 6 DoF (None: the first navigation fix).
-    """
-
-    q_target_BN: np.ndarray
-    t_start_ns: int
-    r_target_N_m: np.ndarray | None = None
-    time_base_ns: int = 0
+    @classmethod
+    def idle(cls, n: int, mode: Mode, fdir_flags: int, imu_counter: int, sensor_flags: int,
+             fdir: FdirReport | None) -> CycleResult:
+        """Every valve closed (boot, safe mode): no demand, nothing allocated."""
+        return cls((0.0,) * n, mode, fdir_flags, False, 0.0, imu_counter, ZERO3, ZERO3,
+                   sensor_flags, fdir)
 
 
 @dataclass
@@ -138,8 +128,6 @@ class FlightComputer:
     thr_status: dict[str, Any] = field(default_factory=dict)
     _imu_t_ns: int | None = None
     _acc_t_ns: int | None = None
-    _q_hold_BN: np.ndarray | None = None
-    _r_hold_N_m: np.ndarray | None = None
     _nav_r: tuple[int, np.ndarray] | None = None
     _nav_v: tuple[int, np.ndarray] | None = None
     _allocator_full: Allocator | None = None
@@ -147,10 +135,11 @@ class FlightComputer:
     inertia_B_kgm2: np.ndarray | None = None  # latest identified inertia (telemetry)
 
     def __post_init__(self) -> None:
+        self._refs = References(self.timeline, self.guidance)
         self._allocator_full = self.allocator
-        self.max_thrust_N = np.broadcast_to(
-            np.asarray(self.max_thrust_N, dtype=float), (len(self.modulators),)
-        ).copy()
+        n = len(self.modulators)
+        self.max_thrust_N = np.array(check.vector("FlightComputer", "max_thrust_N",
+                                                  self.max_thrust_N, n, 0.0, lo_open=True))
 
     # --- sensor input -------------------------------------------------------------------
 
@@ -213,10 +202,7 @@ class FlightComputer:
         self.thr_status = signals
         if self.thruster_fdir is None:
             return
-        n = min(len(self.modulators), MAX_THR_STATUS)
-        cmd = np.array([bool(signals.get(STATUS_CMD[k], 0)) for k in range(n)])
-        opened = np.array([bool(signals.get(STATUS_OPEN[k], 0)) for k in range(n)])
-        current = np.array([bool(signals.get(STATUS_CURRENT[k], 0)) for k in range(n)])
+        cmd, opened, current = status_flags(signals, len(self.modulators))
         self.thruster_fdir.on_valve_status(t_ns, cmd, opened, current)
 
     # --- restart ------------------------------------------------------------------------
@@ -244,7 +230,7 @@ class FlightComputer:
         self.mode = Mode.BOOT
         self.imu_counter = 0
         self._imu_t_ns = self._acc_t_ns = None
-        self._q_hold_BN = self._r_hold_N_m = None
+        self._refs.clear()
         self._nav_r = self._nav_v = None
         self.restarts += 1
 
@@ -285,31 +271,6 @@ class FlightComputer:
         if t_ns - t_r > self.nav_timeout_ns or t_ns - t_v > self.nav_timeout_ns:
             return None
         return r, v
-
-    def _attitude_reference(
-        self, t_ns: int, q_BN: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-        """Reference attitude, rate and acceleration (the last two in body axes)."""
-        tl = self.timeline
-        if self.guidance is not None:
-            ref = self.guidance.reference(t_ns - tl.time_base_ns)
-            q_RN = np.asarray(ref.q_RN, dtype=float)
-            # body axes: C_BR = C_BN C_NR (feed-forward of the reference motion)
-            c_BR = to_dcm(q_BN) @ to_dcm(q_RN).T
-            return q_RN, c_BR @ ref.omega_RN_R, c_BR @ ref.domega_RN_R
-        if t_ns - tl.time_base_ns >= tl.t_start_ns:
-            return tl.q_target_BN, np.zeros(3), None
-        if self._q_hold_BN is None:
-            self._q_hold_BN = np.array(q_BN, dtype=float)
-        return self._q_hold_BN, np.zeros(3), None
-
-    def _position_reference(self, r_N_m: np.ndarray) -> np.ndarray:
-        """The position to hold: the configured target, else the first navigation fix."""
-        if self.timeline.r_target_N_m is not None:
-            return self.timeline.r_target_N_m
-        if self._r_hold_N_m is None:
-            self._r_hold_N_m = r_N_m.copy()
-        return self._r_hold_N_m
 
     def _identify_inertia(self, t_ns: int, omega_BN_B: np.ndarray) -> None:
         """Feed the inertia identifier; hand a new estimate to the laws that use one."""
@@ -361,29 +322,17 @@ class FlightComputer:
                 flags |= FdirFlag.SAFE_LATCHED
             else:
                 self.mode = Mode.BOOT
-            on_idle = (0.0,) * n
             if fdir is not None:
                 fdir.on_command(t_ns, np.zeros(n))
-            return CycleResult(
-                on_idle,
-                self.mode,
-                flags,
-                False,
-                0.0,
-                self.imu_counter,
-                ZERO3,
-                ZERO3,
-                sensor_flags,
-                report,
-            )
+            return CycleResult.idle(n, self.mode, flags, self.imu_counter, sensor_flags, report)
         self.mode = Mode.NOMINAL
         self._identify_inertia(t_ns, est.omega_BN_B)
-        q_ref, w_ref_B, dw_ref_B = self._attitude_reference(t_ns, est.q_BN)
+        q_ref, w_ref_B, dw_ref_B = self._refs.attitude(t_ns, est.q_BN)
         force = np.zeros(3)
         r, v, r_ref = np.zeros(3), np.zeros(3), np.zeros(3)
         if nav is not None:
             r, v = nav
-            r_ref = self._position_reference(r)
+            r_ref = self._refs.position(r)
         if self.pose is not None:
             # without fresh navigation: attitude only, translation coasts
             wrench = self.pose.wrench_B(

@@ -20,7 +20,9 @@ Conventions (those of :mod:`flight_sw.quaternion`, extended):
   dual quaternion ``v`` is ``ṗ_B + ω × p_B`` (eq. 7).
 
 Inputs/outputs: float64 arrays; positions [m], rates [rad/s], velocities [m/s]. Nothing
-here keeps state.
+here keeps state. The products, the twist transformation and the blocks of ``Θ̂`` are
+also given on floats (``_mul``, :func:`transform`, :func:`theta_blocks`: the one
+implementation, which the array functions wrap and the per-cycle laws call).
 
 Assumptions: unit dual quaternions (``|q| = 1``, ``q·q′ = 0``) where a docstring says so,
 not checked, for speed.
@@ -39,6 +41,7 @@ from __future__ import annotations
 import numpy as np
 
 from flight_sw import quaternion as quat
+from flight_sw.vec3 import Mat3, Vec3
 
 HALF = 0.5
 
@@ -154,10 +157,17 @@ def transform_twist(dq: np.ndarray, twist: np.ndarray) -> np.ndarray:
     """
     w1, w2, w3, v1, v2, v3 = np.asarray(twist, dtype=float).tolist()
     a0, a1, a2, a3, c0, c1, c2, c3 = np.asarray(dq, dtype=float).tolist()
+    w, v = transform(a0, a1, a2, a3, c0, c1, c2, c3, (w1, w2, w3), (v1, v2, v3))
+    return np.array((w[0], w[1], w[2], v[0], v[1], v[2]))
+
+
+def transform(a0: float, a1: float, a2: float, a3: float, c0: float, c1: float, c2: float,
+              c3: float, w: Vec3, v: Vec3) -> tuple[Vec3, Vec3]:
+    """:func:`transform_twist` on floats: ``q̂* ∘ (0, w + ϵ v) ∘ q̂`` as (angular, linear)."""
     # (q̂* ∘ ŵ) ∘ q̂, as two products of multiply
-    p = _mul(a0, -a1, -a2, -a3, c0, -c1, -c2, -c3, 0.0, w1, w2, w3, 0.0, v1, v2, v3)
+    p = _mul(a0, -a1, -a2, -a3, c0, -c1, -c2, -c3, 0.0, w[0], w[1], w[2], 0.0, v[0], v[1], v[2])
     out = _mul(p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], a0, a1, a2, a3, c0, c1, c2, c3)
-    return np.array((out[1], out[2], out[3], out[5], out[6], out[7]))
+    return (out[1], out[2], out[3]), (out[5], out[6], out[7])
 
 
 def derivative(dq: np.ndarray, twist: np.ndarray) -> np.ndarray:
@@ -174,17 +184,21 @@ def kinematics_matrix(dq: np.ndarray) -> np.ndarray:
     Block form ``[[Θ, 0], [Θ′, Θ]]`` with ``Θ = ½ (q0 I + [vec(q)×])`` and
     ``Θ′ = ½ (q′0 I + [vec(q′)×])``. Its real block is singular only at ``q0 = 0`` (180°).
     """
-    q0, q1, q2, q3, d0, d1, d2, d3 = (HALF * np.asarray(dq, dtype=float)).tolist()
-    return np.array(
-        (
-            (q0, -q3, q2, 0.0, 0.0, 0.0),
-            (q3, q0, -q1, 0.0, 0.0, 0.0),
-            (-q2, q1, q0, 0.0, 0.0, 0.0),
-            (d0, -d3, d2, q0, -q3, q2),
-            (d3, d0, -d1, q3, q0, -q1),
-            (-d2, d1, d0, -q2, q1, q0),
-        )
-    )
+    e0, e1, e2, e3, e4, e5, e6, e7 = np.asarray(dq, dtype=float).tolist()
+    th, thd = theta_blocks(e0, e1, e2, e3, e4, e5, e6, e7)
+    out = np.zeros((6, 6))
+    out[:3, :3] = out[3:, 3:] = np.reshape(th, (3, 3))
+    out[3:, :3] = np.reshape(thd, (3, 3))
+    return out
+
+
+def theta_blocks(e0: float, e1: float, e2: float, e3: float, d0: float, d1: float,
+                 d2: float, d3: float) -> tuple[Mat3, Mat3]:
+    """The blocks Θ, Θ′ of :func:`kinematics_matrix` on floats (row-major 3×3)."""
+    q0, q1, q2, q3 = HALF * e0, HALF * e1, HALF * e2, HALF * e3
+    p0, p1, p2, p3 = HALF * d0, HALF * d1, HALF * d2, HALF * d3
+    return ((q0, -q3, q2, q3, q0, -q1, -q2, q1, q0),
+            (p0, -p3, p2, p3, p0, -p1, -p2, p1, p0))
 
 
 def kinematics_matrix_rate(dq: np.ndarray, twist: np.ndarray) -> np.ndarray:

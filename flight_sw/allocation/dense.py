@@ -1,44 +1,56 @@
-"""Small dense kernels of the bounded allocators, on Python floats (compiled with mypyc).
+"""Small dense linear algebra on Python floats (compiled with mypyc): the package's one solver.
 
-What it does: the two exact steps that follow OSQP's active-set guess in the bounded
-allocators (:mod:`flight_sw.allocation.qp_osqp`, and the robust ones that share them),
-written out for the problem sizes of a thruster set (n ≤ 16 thrusters, m ≤ 6 demand rows),
-where numpy's per-call overhead (~1-10 µs a call, dozens of calls per solve) is most of the
-time and the arithmetic itself is a few thousand flops:
+What it does: the linear solves of the flight software's per-cycle kernels, written out
+for their sizes (n ≤ 16 unknowns, m ≤ 6 rows), where numpy's per-call overhead (~1-10 µs
+a call, dozens of calls per cycle) is most of the time and the arithmetic is a few
+thousand flops. Users: the allocators' exact active-set stages
+(:mod:`flight_sw.allocation.dense_active_set`) and the RLS inertia identifier's kernel
+(:mod:`flight_sw.estimation.rls_kernel`).
 
-- :func:`box_qp_pdas`: primal-dual active-set rounds for ``min ½ xᵀMx − cᵀx``,
-  ``lo ≤ x ≤ hi``, with ``M`` symmetric positive definite (Hintermüller, Ito & Kunisch 2003,
-  SIAM J. Optim. 13(3) 865–888): each round solves ``M_FF x_F = c_F − M_FA x_A`` on the
-  free set by Cholesky, then moves variables to or from their bounds by the sign of the
-  gradient ``g = Mx − c``; it ends when the active set repeats (the KKT conditions hold).
-- :func:`refine_active_set`: the least-norm least-squares solution ``T_F = B_F⁺ (d − B_A T_A)``
-  on an active set, growing the set when a free value leaves its box (at most n + 1
-  steps); ``B_F⁺`` by the normal equations of the smaller Gram matrix (``B_Fᵀ B_F`` if at
-  most m are free, else ``B_F B_Fᵀ``), by Cholesky.
+- :func:`cholesky_solve`: ``A[idx, idx] x = b`` for a symmetric positive-definite ``A``;
+  None when a pivot is at or below a relative threshold (the matrix is singular or too
+  ill-conditioned for this form: the caller then takes :func:`least_norm_svd`).
+- :func:`least_norm_svd`: the least-norm least-squares solution ``x = A⁺ b`` of any
+  r×c matrix (singular, rank-deficient or ill-conditioned), by the one-sided Jacobi SVD
+  (Hestenes): plane rotations of the columns of ``A`` (or of ``Aᵀ`` when ``A`` has more
+  columns than rows) until every pair is orthogonal to :data:`JACOBI_RTOL`; then
+  ``A V = W`` with orthogonal columns ``w_k = σ_k u_k`` and
+  ``x = Σ_k v_k (w_k·b)/σ_k²`` over the ``σ_k > rcond · max σ`` (the others count as zero,
+  as LAPACK's ``lstsq`` with the same ``rcond``). One-sided Jacobi computes the singular
+  values to high relative accuracy (Demmel & Veselić 1992), so the rank decision is
+  sharp; at most :data:`MAX_JACOBI_SWEEPS` sweeps (it converges quadratically, typically
+  in 5-8).
+- :func:`least_norm`: the least-norm least-squares solution of ``B[:, free] x ≈ r``: by
+  the normal equations of the smaller Gram matrix (``B_Fᵀ B_F`` if at most m are free,
+  else ``B_F B_Fᵀ``) and Cholesky when well conditioned (pivots above
+  :data:`LSQ_PIVOT_RTOL` × their diagonal entry), else by :func:`least_norm_svd` on
+  ``B_F`` itself (no squared condition number).
+- :func:`spd_solve`: ``A[idx, idx] x = b`` by Cholesky, or by :func:`least_norm_svd` with
+  ``rcond`` when a pivot fails (a singular free set: the least-norm solution).
 
-In and out: plain lists (matrices as lists of rows), float64 arithmetic. Each returns None
-where its fast form cannot answer with full accuracy: a Cholesky pivot at or below
-:data:`PD_PIVOT_RTOL` (box QP) or :data:`LSQ_PIVOT_RTOL` (least squares) times its diagonal
-entry, i.e. a singular or ill-conditioned free set; the callers then use their numpy forms
-(LAPACK ``lstsq``, least-norm on singular sets), which define the result in those cases.
-Active-set states: -1 at the lower bound, 0 free, 1 at the upper bound (as
-:mod:`~flight_sw.allocation.qp_osqp`).
+In and out: plain lists (matrices as lists of rows), float64 arithmetic.
 
-Assumptions: ``lo ≤ hi`` elementwise (``lo == hi`` is a fixed variable, held at ``lo``),
-finite inputs.
+Assumptions: finite inputs (a non-finite input gives a non-finite answer, never an
+exception). Sources: Golub & Van Loan 2013, "Matrix Computations", 4th ed., sec. 4.2
+(Cholesky), 5.3 (normal equations), 8.6.3 (one-sided Jacobi SVD); Hestenes 1958, "Inversion
+of matrices by biorthogonalization", J. SIAM 6(1) 51–90; Demmel & Veselić 1992, "Jacobi's
+method is more accurate than QR", SIAM J. Matrix Anal. Appl. 13(4) 1204–1245.
 """
 
 from __future__ import annotations
 
 import math
 
-AT_LOWER, FREE, AT_UPPER = -1, 0, 1
 # A Cholesky pivot of the ε-regularised box-QP matrix below this × its diagonal entry means
 # the matrix is not numerically positive definite (the regularisation keeps it ~1e-6).
 PD_PIVOT_RTOL = 1e-12
 # A Cholesky pivot of a least-squares Gram matrix below this × its diagonal entry (a column
-# within ~1e-4 rad of the others' span: condition number above ~1e4) leaves it to lstsq.
+# within ~1e-4 rad of the others' span: condition number above ~1e4) leaves it to the SVD.
 LSQ_PIVOT_RTOL = 1e-8
+# One-sided Jacobi: a pair of columns counts as orthogonal when |wᵢ·wⱼ| ≤ this × ‖wᵢ‖‖wⱼ‖
+# (a few units of round-off), and at most this many sweeps over all pairs are made.
+JACOBI_RTOL = 1e-15
+MAX_JACOBI_SWEEPS = 40
 
 Matrix = list[list[float]]
 
@@ -79,75 +91,105 @@ def cholesky_solve(a: Matrix, idx: list[int], b: list[float], pivot_rtol: float
     return x
 
 
-def box_qp_pdas(m: Matrix, c: list[float], lo: list[float], hi: list[float],
-                state: list[int], max_rounds: int, xtol_rel: float
-                ) -> tuple[list[float], list[int], bool] | None:
-    """Primal-dual active-set rounds of the box QP (module docstring) from ``state``.
-
-    Returns ``(x, state, settled)``: ``x`` clipped to the box; ``settled`` False when the
-    set did not repeat within ``max_rounds`` (``x`` is then the last round's, a start for a
-    primal active-set method). None when a free-set matrix is not positive definite.
-    ``xtol_rel``: a free value must leave its box by more than this × (hi − lo) to be put
-    on the bound.
-    """
-    n = len(c)
-    st = [AT_LOWER if lo[i] >= hi[i] else state[i] for i in range(n)]
-    x = [min(max(0.0, lo[i]), hi[i]) for i in range(n)]
-    for _ in range(max_rounds):
-        free: list[int] = []
-        for i in range(n):
-            s_i = st[i]
-            if s_i == FREE:
-                free.append(i)
-                x[i] = 0.0
-            else:
-                x[i] = lo[i] if s_i == AT_LOWER else hi[i]
-        if free:
-            rhs: list[float] = []
-            for i in free:
-                row = m[i]
-                s = c[i]
-                for j in range(n):
-                    if st[j] != FREE:
-                        s -= row[j] * x[j]
-                rhs.append(s)
-            sol = cholesky_solve(m, free, rhs, PD_PIVOT_RTOL)
-            if sol is None:
-                return None
-            for k in range(len(free)):
-                x[free[k]] = sol[k]
-        new = [FREE] * n
-        for i in range(n):
-            if lo[i] >= hi[i]:
-                new[i] = AT_LOWER
-                continue
-            s_i = st[i]
-            if s_i == FREE:
-                xtol = xtol_rel * (hi[i] - lo[i])
-                if x[i] < lo[i] - xtol:
-                    new[i] = AT_LOWER
-                elif x[i] > hi[i] + xtol:
-                    new[i] = AT_UPPER
-                continue
-            row = m[i]
-            g = -c[i]
-            for j in range(n):
-                g += row[j] * x[j]
-            if s_i == AT_UPPER and g <= 0.0:
-                new[i] = AT_UPPER
-            elif s_i == AT_LOWER and g >= 0.0:
-                new[i] = AT_LOWER
-        if new == st:
-            return [min(max(x[i], lo[i]), hi[i]) for i in range(n)], st, True
-        st = new
-    return x, st, False
+def _jacobi_columns(cols: Matrix) -> Matrix:
+    """Rotate the columns ``cols`` (each a list) in place until pairwise orthogonal; return
+    the accumulated rotation ``V`` (as columns: ``V[k]`` is the k-th right singular vector)."""
+    k = len(cols)
+    v: Matrix = [[1.0 if i == j else 0.0 for i in range(k)] for j in range(k)]
+    for _ in range(MAX_JACOBI_SWEEPS):
+        rotated = False
+        for i in range(k - 1):
+            ci = cols[i]
+            vi = v[i]
+            for j in range(i + 1, k):
+                cj = cols[j]
+                alpha = 0.0
+                beta = 0.0
+                gamma = 0.0
+                for e in range(len(ci)):
+                    alpha += ci[e] * ci[e]
+                    beta += cj[e] * cj[e]
+                    gamma += ci[e] * cj[e]
+                if not abs(gamma) > JACOBI_RTOL * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = math.copysign(1.0, zeta) / (abs(zeta) + math.hypot(1.0, zeta))
+                cs = 1.0 / math.sqrt(1.0 + t * t)
+                sn = cs * t
+                for e in range(len(ci)):
+                    p, q = ci[e], cj[e]
+                    ci[e] = cs * p - sn * q
+                    cj[e] = sn * p + cs * q
+                vj = v[j]
+                for e in range(k):
+                    p, q = vi[e], vj[e]
+                    vi[e] = cs * p - sn * q
+                    vj[e] = sn * p + cs * q
+        if not rotated:
+            break
+    return v
 
 
-def least_norm(b: Matrix, free: list[int], r: list[float]) -> list[float] | None:
-    """The least-norm least-squares ``x`` of ``B[:, free] x ≈ r`` by the normal equations of
-    the smaller Gram matrix; None when that matrix is ill-conditioned (LSQ_PIVOT_RTOL)."""
+def least_norm_svd(a: Matrix, b: list[float], rcond: float) -> list[float]:
+    """``x = A⁺ b``, the least-norm least-squares solution of ``A x ≈ b`` (A: r×c rows),
+    singular values ``σ ≤ rcond · max σ`` counted as zero (module docstring)."""
+    rows = len(a)
+    cols_a = len(a[0]) if rows else 0
+    if rows == 0 or cols_a == 0:
+        return [0.0] * cols_a
+    transpose = rows < cols_a
+    if transpose:  # columns of Aᵀ (the rows of A): fewer of them
+        w = [list(a[i]) for i in range(rows)]
+    else:
+        w = [[a[i][j] for i in range(rows)] for j in range(cols_a)]
+    v = _jacobi_columns(w)
+    norms2 = [0.0] * len(w)
+    sigma_max = 0.0
+    for k in range(len(w)):
+        s = 0.0
+        for val in w[k]:
+            s += val * val
+        norms2[k] = s
+        sigma_max = max(sigma_max, math.sqrt(s))
+    x = [0.0] * cols_a
+    for k in range(len(w)):
+        if not math.sqrt(norms2[k]) > rcond * sigma_max or norms2[k] == 0.0:
+            continue
+        wk = w[k]
+        vk = v[k]
+        s = 0.0
+        if transpose:  # Aᵀ V = W: x = Σ_k w_k (v_k·b)/σ_k²
+            for e in range(rows):
+                s += vk[e] * b[e]
+            coef = s / norms2[k]
+            for e in range(cols_a):
+                x[e] += coef * wk[e]
+        else:  # A V = W: x = Σ_k v_k (w_k·b)/σ_k²
+            for e in range(rows):
+                s += wk[e] * b[e]
+            coef = s / norms2[k]
+            for e in range(cols_a):
+                x[e] += coef * vk[e]
+    return x
+
+
+def spd_solve(a: Matrix, idx: list[int], b: list[float], pivot_rtol: float, rcond: float
+              ) -> list[float]:
+    """``A[idx, idx] x = b`` for a symmetric positive semi-definite ``A``: Cholesky while its
+    pivots stay above ``pivot_rtol``, else the least-norm solution (:func:`least_norm_svd`)."""
+    x = cholesky_solve(a, idx, b, pivot_rtol)
+    if x is not None:
+        return x
+    return least_norm_svd([[a[i][j] for j in idx] for i in idx], b, rcond)
+
+
+def least_norm(b: Matrix, free: list[int], r: list[float], rcond: float) -> list[float]:
+    """The least-norm least-squares ``x`` of ``B[:, free] x ≈ r`` (module docstring): normal
+    equations of the smaller Gram matrix when well conditioned, else the SVD of ``B_F``."""
     rows = len(b)
     f = len(free)
+    x: list[float] | None
     if f <= rows:  # (B_Fᵀ B_F) x = B_Fᵀ r
         gram = [[0.0] * f for _ in range(f)]
         rhs = [0.0] * f
@@ -164,76 +206,28 @@ def least_norm(b: Matrix, free: list[int], r: list[float]) -> list[float] | None
                     s += b[k][ci] * b[k][cj]
                 gram[i][j] = s
                 gram[j][i] = s
-        return cholesky_solve(gram, list(range(f)), rhs, LSQ_PIVOT_RTOL)
-    gram = [[0.0] * rows for _ in range(rows)]  # (B_F B_Fᵀ) y = r, x = B_Fᵀ y
-    for i in range(rows):
-        b_i = b[i]
-        for j in range(i + 1):
-            b_j = b[j]
-            s = 0.0
-            for cf in free:
-                s += b_i[cf] * b_j[cf]
-            gram[i][j] = s
-            gram[j][i] = s
-    y = cholesky_solve(gram, list(range(rows)), r, LSQ_PIVOT_RTOL)
-    if y is None:
-        return None
-    x = [0.0] * f
-    for i in range(f):
-        cf = free[i]
-        s = 0.0
-        for k in range(rows):
-            s += b[k][cf] * y[k]
-        x[i] = s
-    return x
-
-
-def refine_active_set(b: Matrix, d: list[float], t: list[float], lo: list[float],
-                      hi: list[float], active_rtol: float) -> tuple[bool, list[float] | None]:
-    """The least-norm least-squares thrusts on the active set of ``t`` (module docstring).
-
-    A value within ``active_rtol`` × (hi − lo) of a bound is held there. Returns
-    ``(True, x)``, or ``(True, None)`` when the free values keep leaving the box, or
-    ``(False, None)`` when a least-squares step was ill-conditioned (the caller decides
-    with lstsq).
-    """
-    n = len(t)
-    rows = len(b)
-    tol = [active_rtol * (hi[i] - lo[i]) for i in range(n)]
-    state = [FREE] * n
-    for i in range(n):
-        if t[i] <= lo[i] + tol[i]:
-            state[i] = AT_LOWER
-        elif t[i] >= hi[i] - tol[i]:
-            state[i] = AT_UPPER
-    for _ in range(n + 1):
-        out = [lo[i] if state[i] == AT_LOWER else hi[i] if state[i] == AT_UPPER else 0.0
-               for i in range(n)]
-        free = [i for i in range(n) if state[i] == FREE]
-        if not free:
-            return True, out
-        r = [0.0] * rows
-        for k in range(rows):
-            b_k = b[k]
-            s = d[k]
-            for j in range(n):
-                s -= b_k[j] * out[j]
-            r[k] = s
-        sol = least_norm(b, free, r)
-        if sol is None:
-            return False, None
-        moved = False
-        for k in range(len(free)):
-            i = free[k]
-            if sol[k] < lo[i] - tol[i]:
-                state[i] = AT_LOWER
-                moved = True
-            elif sol[k] > hi[i] + tol[i]:
-                state[i] = AT_UPPER
-                moved = True
-        if not moved:
-            for k in range(len(free)):
-                i = free[k]
-                out[i] = min(max(sol[k], lo[i]), hi[i])
-            return True, out
-    return True, None
+        x = cholesky_solve(gram, list(range(f)), rhs, LSQ_PIVOT_RTOL)
+    else:
+        gram = [[0.0] * rows for _ in range(rows)]  # (B_F B_Fᵀ) y = r, x = B_Fᵀ y
+        for i in range(rows):
+            b_i = b[i]
+            for j in range(i + 1):
+                b_j = b[j]
+                s = 0.0
+                for cf in free:
+                    s += b_i[cf] * b_j[cf]
+                gram[i][j] = s
+                gram[j][i] = s
+        y = cholesky_solve(gram, list(range(rows)), r, LSQ_PIVOT_RTOL)
+        x = None
+        if y is not None:
+            x = [0.0] * f
+            for i in range(f):
+                cf = free[i]
+                s = 0.0
+                for k in range(rows):
+                    s += b[k][cf] * y[k]
+                x[i] = s
+    if x is not None:
+        return x
+    return least_norm_svd([[b[k][cf] for cf in free] for k in range(rows)], r, rcond)

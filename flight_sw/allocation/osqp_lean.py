@@ -15,6 +15,10 @@ bounds to ±``OSQP_INFTY``: the numbers are the same, bit for bit (tests/flight_
 test_osqp_lean.py runs the allocators both ways). When the binding is not there (another
 osqp release), the public API is used.
 
+:func:`osqp_settings` gives the allocators' OSQP settings (silent, deterministic: bounded
+iterations, no time limit), in two flavours: tight (the robust SQP's subproblems) and the
+loose stage-one guess of an active set that an exact dense solve then finishes.
+
 Units: whatever the problem's are. Assumptions: the problem was set up with
 :meth:`osqp.OSQP.setup`; matrix updates keep its sparsity pattern (OSQP's own rule).
 Source: OSQP 1.x Python interface (``osqp/interface.py``: ``update``, ``solve``).
@@ -28,6 +32,35 @@ import numpy as np
 import osqp
 
 _BINDING_METHODS = ("update_data_vec", "update_data_mat", "solve", "info", "solution")
+# OSQP settings: tight tolerances, bounded iterations, iteration-counted rho adaptation,
+# no time limit (OSQP 1.x has no "off" value; 1e10 s is its default, i.e. never reached).
+OSQP_EPS_ABS = 1e-9
+OSQP_EPS_REL = 1e-9
+OSQP_MAX_ITER = 4000
+OSQP_CHECK_TERMINATION = 10
+OSQP_ADAPTIVE_RHO_ITERATIONS = 1  # OSQP 1.x: adapt rho every `interval` iterations
+OSQP_ADAPTIVE_RHO_INTERVAL = 25
+OSQP_TIME_LIMIT_OFF_S = 1e10
+# BoundedQpAllocator only needs OSQP's active set (box_qp then solves exactly): loose
+# tolerances, no polishing, and a low iteration bound keep its worst case short.
+OSQP_STAGE_ONE_EPS = 1e-4
+OSQP_STAGE_ONE_MAX_ITER = 60
+
+
+def osqp_settings(warm_start: bool, stage_one: bool = False) -> dict[str, Any]:
+    """OSQP settings (silent, deterministic); ``stage_one``: the loose active-set guess."""
+    return {
+        "verbose": False,
+        "polishing": not stage_one,
+        "warm_starting": warm_start,
+        "eps_abs": OSQP_STAGE_ONE_EPS if stage_one else OSQP_EPS_ABS,
+        "eps_rel": OSQP_STAGE_ONE_EPS if stage_one else OSQP_EPS_REL,
+        "max_iter": OSQP_STAGE_ONE_MAX_ITER if stage_one else OSQP_MAX_ITER,
+        "check_termination": OSQP_CHECK_TERMINATION,
+        "adaptive_rho": OSQP_ADAPTIVE_RHO_ITERATIONS,
+        "adaptive_rho_interval": OSQP_ADAPTIVE_RHO_INTERVAL,
+        "time_limit": OSQP_TIME_LIMIT_OFF_S,
+    }
 
 
 class OsqpResult(NamedTuple):

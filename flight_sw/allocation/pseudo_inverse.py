@@ -1,7 +1,8 @@
-"""Bounded pseudo-inverse allocation for on-off thrusters (thrust in [0, T_max]).
+"""Bounded pseudo-inverse allocation for on-off thrusters (thrust in [0, T_max,i]).
 
 What it does: maps a torque (m = 3) or wrench (m = 6) demand ``d`` to thrusts ``T`` with
-``B T ≈ d`` and ``0 ≤ T_i ≤ T_max``, in up to three cheap steps:
+``B T ≈ d`` and ``0 ≤ T_i ≤ T_max,i`` (each thruster its own maximum, e.g. seed 001's
+opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
 
 1. Minimum-norm solution ``T = B⁺ d`` (B⁺ the Moore–Penrose pseudo-inverse of the
    effectiveness matrix restricted to the available thrusters; computed once).
@@ -14,22 +15,33 @@ What it does: maps a torque (m = 3) or wrench (m = 6) demand ``d`` to thrusts ``
    opposing thruster of ``i`` (a pure couple), so a pure pitch demand fires exactly one
    couple. A single strictly positive null vector ``v`` (found by "maximise t subject to
    B v = 0, Σ v = 1, v_i ≥ t") must exist: the thrusters must positively span the
-   attainable space; it also serves step 3.
-3. Upper bound: if ``max T > T_max``:
-   a. if the demand is *attainable* (inside the attainable set ``B·[0, T_max]ⁿ``, a
-      zonotope whose facet inequalities are precomputed, so the test is one small
-      matrix-vector product) and ``exact_repair`` is on, solve the bounded least-squares
+   attainable space; it also serves step 3. Steps 1–2 do not depend on the bounds.
+3. Upper bounds: if some ``T_i > T_max,i``:
+   a. if the demand is *attainable* — inside the attainable set
+      ``A = {B T : 0 ≤ T_i ≤ T_max,i} = Σ_j [0, T_max,j] g_j`` (``g_j`` the columns of
+      ``B``), a zonotope — and ``exact_repair`` is on, solve the bounded least-squares
       problem ``min ‖B T − d‖, 0 ≤ T ≤ T_max`` (scipy ``lsq_linear``, BVLS), which then has
-      a zero residual: an attainable demand is always reproduced exactly;
-   b. otherwise scale the whole vector by ``T_max / max T`` (direction-preserving
-      saturation: the achieved demand keeps the direction of the attainable part of
-      ``d``), reported as ``saturated``.
+      a zero residual: an attainable demand is always reproduced exactly. The test is one
+      small matrix-vector product against the facet inequalities ``n·x ≤ h(n)``
+      precomputed at construction: a facet normal ``n`` is orthogonal to r − 1
+      independent generators (the bounds scale the generators, not their directions,
+      so the normals are those of ``B``), with support ``h(n) = Σ_j T_max,j max(n·g_j, 0)``
+      (Durham 1994 for equal bounds; the per-generator weight is each segment's length);
+   b. otherwise scale the whole vector by ``s = min_{i: T_i > T_max,i} T_max,i / T_i``,
+      the largest factor that brings every thruster within its own bound
+      (direction-preserving saturation: the achieved demand keeps the direction of the
+      attainable part of ``d``; with equal bounds ``s = T_max / max T``), reported as
+      ``saturated``.
    Why 3a exists: the single fixed shift direction of step 2 does not reach every
    attainable demand. For the seed-003 layout the shifted pseudo-inverse needs up to
    1.5 T_max on attainable demands (e.g. thrusters 3, 4, 5, 6 and 8 all at T_max need
    1.25 T_max); about 0.6 % (torque) and 2 % (wrench) of demands ``B·U(0, T_max)⁸``
    overflow. Step 3a runs only for those (≈ 60–120 µs each); unattainable demands,
    the common saturated case during slews, take the cheap step 3b.
+   With equal bounds every quantity above is computed exactly as the scalar form did
+   (``h = T_max Σ_j max(n·g_j, 0)``, ``s = T_max / max T``), bit for bit: the bounds
+   enter as ``T_max,ref × (T_max,j / T_max,ref)`` with ``T_max,ref = max_j T_max,j``, and
+   the ratios are exactly 1.
 
 Fallback: when no strictly positive null vector exists (fewer or badly placed available
 thrusters, e.g. after masking), steps 1–3 do not apply and every call solves the bounded
@@ -38,13 +50,14 @@ reproduced, others get the bounded least-squares optimum (not direction-preservi
 :attr:`PseudoInverseAllocator.uses_null_space_shift` tells which path an instance uses.
 
 Inputs: ``effectiveness`` (m×n, rows as in :mod:`flight_sw.allocation.effectiveness`:
-torque rows [N m/N] or wrench rows); ``params.max_thrust_N`` [N]; availability ``mask``
-(n booleans, True = usable; masked thrusters get exactly 0 N, and their columns are
-removed before the pseudo-inverse, the null vector and the attainable set are computed).
-Output: :class:`AllocationResult` (thrust [N], achieved demand, residual, saturated).
-Every returned thrust lies in [0, T_max]. A non-finite demand yields all zeros with an
-infinite residual, flagged saturated; with every thruster masked the result is all zeros,
-flagged saturated unless the demand is zero.
+torque rows [N m/N] or wrench rows); ``params.max_thrust_N`` [N], one number or one per
+thruster (shape (n,)); availability ``mask`` (n booleans, True = usable; masked thrusters
+get exactly 0 N, and their columns are removed before the pseudo-inverse, the null vector
+and the attainable set are computed). Output:
+:class:`~flight_sw.allocation.base.AllocationResult` (thrust [N], achieved demand,
+residual, saturated). Every returned thrust lies in [0, T_max,i]. A non-finite demand
+yields all zeros with an infinite residual, flagged saturated; with every thruster masked
+the result is all zeros, flagged saturated unless the demand is zero (the base class).
 
 Assumptions: mean thrust over a control period is what the modulators realise
 downstream; thrusters are independent; the attainable-set test enumerates
@@ -65,28 +78,21 @@ algorithm and applications", Comput. Stat. 10(2) 129–141.
 from __future__ import annotations
 
 import itertools
-import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import linprog, lsq_linear
 
-from dbc.errors import ConfigError
-from flight_sw.allocation.base import AllocationResult
+from flight_sw import validation as check
+from flight_sw.allocation.base import RANK_RTOL, BoundSpec, ControlAllocation
 
-MAX_DEMAND_DIM = 6
-# Singular values below RANK_RTOL × the largest count as zero (rank of B).
-RANK_RTOL = 1e-10
 # Smallest component (of a unit-sum null vector) accepted as "strictly positive".
 NULL_VECTOR_MIN_COMPONENT = 1e-9
-# Thrust above T_max × (1 + THRUST_RTOL) counts as an overflow (round-off slack).
+# Thrust above T_max,i × (1 + THRUST_RTOL) counts as an overflow (round-off slack).
 THRUST_RTOL = 1e-12
-# A residual below ATTAINED_RTOL × (T_max × largest column norm of B) counts as zero.
-ATTAINED_RTOL = 1e-9
 
-_SOURCE = "PseudoInverseAllocator"
+_SOURCE = "PseudoInverseParams"
 
 
 @dataclass(frozen=True)
@@ -94,28 +100,23 @@ class PseudoInverseParams:
     """Parameters of the bounded pseudo-inverse allocator.
 
     Attributes:
-        max_thrust_N: maximum (on-state) thrust of every thruster [N] (> 0).
+        max_thrust_N: maximum (on-state) thrust [N] (> 0): one number for every thruster,
+            or a tuple with one per thruster.
         exact_repair: solve the bounded least-squares problem when the shifted
             pseudo-inverse overflows on an attainable demand (step 3a); False gives the
             plain pseudo-inverse + shift + scaling behaviour.
     """
 
-    max_thrust_N: float
+    max_thrust_N: BoundSpec
     exact_repair: bool = True
 
     def __post_init__(self) -> None:
         t = self.max_thrust_N
-        if not (
-            isinstance(t, numbers.Real) and not isinstance(t, bool) and math.isfinite(t) and t > 0
-        ):
-            raise ConfigError("PseudoInverseParams", "max_thrust_N", t, "a finite number > 0")
-        if not isinstance(self.exact_repair, bool):
-            raise ConfigError("PseudoInverseParams", "exact_repair", self.exact_repair, "a bool")
-
-
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a.setflags(write=False)
-    return a
+        if isinstance(t, tuple):
+            check.vector(_SOURCE, "max_thrust_N", t, None, 0.0, lo_open=True, unit="N")
+        else:
+            check.positive(_SOURCE, "max_thrust_N", t, unit="N")
+        check.flag(_SOURCE, "exact_repair", self.exact_repair)
 
 
 def _positive_null_vector(b: np.ndarray, pinv: np.ndarray) -> np.ndarray | None:
@@ -156,12 +157,13 @@ def _min_fuel_null_rays(b: np.ndarray) -> np.ndarray | None:
     return rays
 
 
-def _attainable_halfspaces(g: np.ndarray, max_thrust_N: float) -> tuple[np.ndarray, np.ndarray]:
-    """Facet inequalities ``N x ≤ h`` of the zonotope ``G·[0, T_max]ⁿ`` (G: r×n, rank r).
+def _attainable_halfspaces(g: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Facet inequalities ``N x ≤ h`` of the zonotope ``Σ_j [0, w_j] g_j`` (G: r×n, rank r).
 
     Every facet normal is orthogonal to r − 1 independent generators; all such directions
     (both signs) are enumerated; extra non-facet directions only add redundant
-    (still valid) supporting half-spaces.
+    (still valid) supporting half-spaces. ``h = Σ_j w_j max(N g_j, 0)`` (``w``: the
+    generators' lengths, the thrust bounds relative to the largest).
     """
     r, n = g.shape
     if r == 1:
@@ -174,12 +176,14 @@ def _attainable_halfspaces(g: np.ndarray, max_thrust_N: float) -> tuple[np.ndarr
         normals = u[independent, :, -1]
         normals = np.vstack([normals, -normals])
         normals = np.unique(np.round(normals, 12), axis=0)
-    h = max_thrust_N * np.maximum(normals @ g, 0.0).sum(axis=1)
+    h = (np.maximum(normals @ g, 0.0) * weights).sum(axis=1)
     return normals, h
 
 
-class PseudoInverseAllocator:
-    """Bounded pseudo-inverse allocator with null-space shift (implements ``Allocator``)."""
+class PseudoInverseAllocator(ControlAllocation):
+    """Bounded pseudo-inverse allocator with null-space shift (a ``ControlAllocation``)."""
+
+    _source = "PseudoInverseAllocator"
 
     def __init__(
         self,
@@ -187,64 +191,25 @@ class PseudoInverseAllocator:
         params: PseudoInverseParams,
         mask: Sequence[bool] | np.ndarray | None = None,
     ) -> None:
-        b = np.array(effectiveness, dtype=float)
-        if b.ndim != 2 or not (1 <= b.shape[0] <= MAX_DEMAND_DIM) or b.shape[1] == 0:
-            raise ConfigError(_SOURCE, "effectiveness", b.shape, "an m×n array, 1 <= m <= 6")
-        if not np.all(np.isfinite(b)):
-            raise ConfigError(_SOURCE, "effectiveness", "non-finite", "finite values")
-        m, n = b.shape
-        if mask is None:
-            mask_arr = np.ones(n, dtype=bool)
-        else:
-            raw = np.asarray(mask)
-            if raw.shape != (n,) or raw.dtype != bool:
-                raise ConfigError(_SOURCE, "mask", mask, f"{n} booleans (True = usable)")
-            mask_arr = raw.copy()
-        self._b = b
-        self._b.setflags(write=False)
-        self._params = params
-        self._mask = _frozen(mask_arr)
-        self._avail = np.flatnonzero(mask_arr)
-        self._tmax = float(params.max_thrust_N)
-        b_a = b[:, self._avail]
-        self._b_a = b_a
+        super().__init__(effectiveness, params, mask, 0.0, params.max_thrust_N)
+        m = self._b.shape[0]
+        b_a = self._b_a
+        u_a = self._hi_a
         self._pinv = np.linalg.pinv(b_a, rcond=RANK_RTOL) if self._avail.size else np.zeros((0, m))
-        if self._avail.size:
-            u, s, _ = np.linalg.svd(b_a, full_matrices=False)
-            rank = int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
-        else:
-            u, rank = np.zeros((m, 0)), 0
-        self._range_basis_T = u[:, :rank].T.copy()  # rows: orthonormal basis of range(B_a)
-        col_norm = float(np.max(np.linalg.norm(b_a, axis=0))) if self._avail.size else 0.0
-        self._attained_tol = ATTAINED_RTOL * max(self._tmax * col_norm, 1.0)
+        rank = self._range_T.shape[0]
         self._null_v = _positive_null_vector(b_a, self._pinv) if rank else None
         self._rays = _min_fuel_null_rays(b_a) if self._null_v is not None else None
-        # Per-call helpers: −1/v for the shift, the overflow threshold, and the attainable-set
+        # Per-call helpers: −1/v for the shift, the overflow thresholds, and the attainable-set
         # inequalities mapped to demand space, ``normals·U_rᵀ d ≤ h + tol``.
         self._neg_inv_v = None if self._null_v is None else -1.0 / self._null_v
-        self._overflow_N = self._tmax * (1.0 + THRUST_RTOL)
-        self._all_available = bool(mask_arr.all())
+        self._overflow_N = u_a * (1.0 + THRUST_RTOL)
         self._halfspaces: tuple[np.ndarray, np.ndarray] | None = None
         if self._null_v is not None and params.exact_repair and rank:
-            normals, h = _attainable_halfspaces(self._range_basis_T @ b_a, self._tmax)
-            self._halfspaces = (normals @ self._range_basis_T, h + self._attained_tol)
+            u_ref = float(np.max(u_a))
+            normals, h = _attainable_halfspaces(self._range_T @ b_a, u_a / u_ref)
+            self._halfspaces = (normals @ self._range_T, u_ref * h + self._attained_tol)
 
     # --- introspection -----------------------------------------------------------------
-
-    @property
-    def params(self) -> PseudoInverseParams:
-        """The parameters this allocator was built with."""
-        return self._params
-
-    @property
-    def mask(self) -> np.ndarray:
-        """The availability mask (read-only; True = usable)."""
-        return self._mask
-
-    @property
-    def effectiveness(self) -> np.ndarray:
-        """The full m×n effectiveness matrix (read-only, masked columns included)."""
-        return self._b
 
     @property
     def uses_null_space_shift(self) -> bool:
@@ -260,10 +225,6 @@ class PseudoInverseAllocator:
         v[self._avail] = self._null_v
         return v
 
-    def with_mask(self, mask: Sequence[bool] | np.ndarray) -> PseudoInverseAllocator:
-        """A new allocator for the same thrusters with availability ``mask``."""
-        return PseudoInverseAllocator(self._b, self._params, mask)
-
     # --- allocation --------------------------------------------------------------------
 
     def _attainable(self, d: np.ndarray) -> bool:
@@ -273,25 +234,14 @@ class PseudoInverseAllocator:
         return bool((normals_d @ d <= h_tol).all())
 
     def _bounded_lsq(self, d: np.ndarray) -> np.ndarray:
-        res = lsq_linear(self._b_a, d, bounds=(0.0, self._tmax), method="bvls")
+        res = lsq_linear(self._b_a, d, bounds=(0.0, self._hi_a), method="bvls")
         return np.asarray(res.x, dtype=float)
 
     def _in_range_residual(self, d: np.ndarray, t_a: np.ndarray) -> float:
-        return float(np.linalg.norm(self._range_basis_T @ (d - self._b_a @ t_a)))
+        return float(np.linalg.norm(self._range_T @ (d - self._b_a @ t_a)))
 
-    def allocate(self, demand: np.ndarray) -> AllocationResult:
-        """Thrusts [N] for the torque/wrench ``demand`` (see the module docstring)."""
-        d = np.asarray(demand, dtype=float)
-        m, n = self._b.shape
-        if d.shape != (m,):
-            raise ValueError(f"demand has shape {d.shape}, expected ({m},)")
-        finite = all(map(math.isfinite, d.tolist()))
-        if not finite or self._avail.size == 0:
-            residual = float(np.linalg.norm(d)) if finite else math.inf
-            return AllocationResult(
-                _frozen(np.zeros(n)), _frozen(np.zeros(m)), residual, residual > 0.0
-            )
-        tmax = self._tmax
+    def _solve(self, d: np.ndarray) -> tuple[np.ndarray, bool | None]:
+        u_a = self._hi_a
         saturated = False
         neg_inv_v = self._neg_inv_v
         if neg_inv_v is None or self._null_v is None:
@@ -309,27 +259,19 @@ class PseudoInverseAllocator:
                 alpha = float((t_a * neg_inv_v).max())
                 if alpha > 0.0:
                     t_a += alpha * self._null_v
-            peak = float(t_a.max())
-            if peak > self._overflow_N:
+            over = t_a > self._overflow_N
+            if over.any():
                 repaired = None
                 if self._attainable(d):
                     candidate = self._bounded_lsq(d)
                     if self._in_range_residual(d, candidate) <= self._attained_tol:
                         repaired = candidate
                 if repaired is None:
-                    t_a *= tmax / peak
+                    # min over the overflowing thrusters of T_max,i/T_i (the others give ≥ it)
+                    t_a *= float((u_a / np.maximum(t_a, u_a)).min())
                     saturated = True
                 else:
                     t_a = repaired
         np.maximum(t_a, 0.0, out=t_a)
-        np.minimum(t_a, tmax, out=t_a)
-        if self._all_available:
-            thrust = t_a
-        else:
-            thrust = np.zeros(n)
-            thrust[self._avail] = t_a
-        achieved = self._b @ thrust
-        r = d - achieved
-        return AllocationResult(
-            _frozen(thrust), _frozen(achieved), math.sqrt(float(r @ r)), saturated
-        )
+        np.minimum(t_a, u_a, out=t_a)
+        return t_a, saturated

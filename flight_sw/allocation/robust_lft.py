@@ -25,10 +25,10 @@ function) with ``φ'(τ) = ∂f/∂τ`` at the inner minimiser ``T(τ)`` (Danski
 
 1. inner problem (τ fixed): the box QP ``min TᵀM T − 2cᵀT`` with
    ``M = CᵀDC + HᵀH/τ + εI``, ``c = CᵀD Uᵀv``, ``C = UᵀB₀``, ``D = diag(1/(1 − τ sⱼ))``,
-   solved exactly by the dense active-set :func:`~flight_sw.allocation.qp_osqp.box_qp`,
+   solved exactly by the dense active-set :func:`~flight_sw.allocation.active_set.box_qp`,
    warm-started from the previous active set;
 2. outer problem: ``φ'(τ) = 0`` on ``θ = τ·max s ∈ [THETA_MIN, LFT_THETA_MAX]`` by
-   safeguarded Newton (:func:`~flight_sw.allocation.qp_osqp.monotone_root`; ``φ''`` from
+   safeguarded Newton (:func:`~flight_sw.allocation.root_finding.monotone_root`; ``φ''`` from
    the sensitivity of ``T`` on its active set: ``f_ττ − 2 wᵀ M_FF⁻¹ w``), started from the
    previous allocation's θ (cold: :data:`LFT_THETA_START`). It stops when the Newton
    decrement ``φ'²/φ''`` (≈ ``φ(τ) − min φ``) is below :data:`LFT_RTOL` × ``f`` — a global
@@ -71,28 +71,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
-from flight_sw.allocation.base import AllocationResult
-from flight_sw.allocation.qp_osqp import (
-    ACTIVE_RTOL,
-    DEFAULT_REGULARIZATION,
-    FREE,
-    REFINE_RTOL,
+from flight_sw import validation as check
+from flight_sw.allocation.active_set import FREE, bound_active, box_qp, refine
+from flight_sw.allocation.base import (
+    RANK_RTOL,
     BoundSpec,
-    attained_tolerance,
-    box_qp,
+    ControlAllocation,
     check_bound_spec,
-    check_demand,
-    check_effectiveness,
-    check_positive,
     frozen,
-    is_real,
-    monotone_root,
-    parse_mask,
-    range_basis_T,
-    refine_on_active_set,
-    thrust_bounds,
-    trivial_result,
 )
+from flight_sw.allocation.dense import PD_PIVOT_RTOL, spd_solve
+from flight_sw.allocation.qp_osqp import DEFAULT_REGULARIZATION
+from flight_sw.allocation.root_finding import monotone_root
 from flight_sw.allocation.uncertainty import (
     EIG_RTOL,
     SEED001_RHO,
@@ -114,16 +104,6 @@ LFT_THETA_MAX = 1.0 - 1e-6
 _SOURCE = "RobustLftParams"
 
 Matrix = tuple[tuple[float, ...], ...]
-
-
-def _matrix(source: str, key: str, value: object) -> None:
-    ok = isinstance(value, tuple) and len(value) > 0
-    if ok and isinstance(value, tuple):
-        ok = all(isinstance(r, tuple) and len(r) == len(value[0]) > 0 for r in value)
-        ok = ok and all(is_real(x) for r in value for x in r)
-        ok = ok and bool(np.all(np.isfinite(np.array(value, dtype=float))))
-    if not ok:
-        raise ConfigError(source, key, value, "a non-empty rectangular tuple of tuples of numbers")
 
 
 @dataclass(frozen=True)
@@ -153,21 +133,22 @@ class RobustLftParams:
     def __post_init__(self) -> None:
         check_bound_spec(_SOURCE, "upper_N", self.upper_N)
         check_bound_spec(_SOURCE, "lower_N", self.lower_N)
-        check_positive(_SOURCE, "rho", self.rho, allow_zero=True)
-        check_positive(_SOURCE, "regularization", self.regularization, allow_zero=True)
-        if self.e_shape is not None:
-            _matrix(_SOURCE, "e_shape", self.e_shape)
-        if self.h_matrix is not None:
-            _matrix(_SOURCE, "h_matrix", self.h_matrix)
-        it = self.max_iter
-        if not (isinstance(it, int) and not isinstance(it, bool) and it >= 1):
-            raise ConfigError(_SOURCE, "max_iter", it, "an int >= 1")
-        if not isinstance(self.warm_start, bool):
-            raise ConfigError(_SOURCE, "warm_start", self.warm_start, "a bool")
+        check.non_negative(_SOURCE, "rho", self.rho)
+        check.non_negative(_SOURCE, "regularization", self.regularization)
+        for key in ("e_shape", "h_matrix"):
+            value = getattr(self, key)
+            if value is not None and not isinstance(value, tuple):
+                raise ConfigError(_SOURCE, key, value, "a tuple of tuples of finite numbers")
+            if value is not None:
+                check.matrix(_SOURCE, key, value)
+        check.integer(_SOURCE, "max_iter", self.max_iter, 1)
+        check.flag(_SOURCE, "warm_start", self.warm_start)
 
 
-class RobustLftAllocator:
-    """Exact worst-case least squares under ``ΔB = E F H``, ``‖F‖ ≤ 1`` (an ``Allocator``)."""
+class RobustLftAllocator(ControlAllocation):
+    """Exact worst-case least squares under ``ΔB = E F H``, ``‖F‖ ≤ 1`` (seed 001, Thm 3)."""
+
+    _source = "RobustLftAllocator"
 
     def __init__(
         self,
@@ -175,10 +156,10 @@ class RobustLftAllocator:
         params: RobustLftParams,
         mask: Sequence[bool] | np.ndarray | None = None,
     ) -> None:
-        src = "RobustLftAllocator"
-        b = check_effectiveness(src, effectiveness)
+        super().__init__(effectiveness, params, mask, params.lower_N, params.upper_N)
+        src = self._source
+        b = self._b
         m, n = b.shape
-        lo, hi = thrust_bounds(src, params.lower_N, params.upper_N, n)
         e_shape = np.eye(m) if params.e_shape is None else np.array(params.e_shape, dtype=float)
         if e_shape.shape[0] != m:
             raise ConfigError(src, "e_shape", e_shape.shape, f"{m} rows")
@@ -188,26 +169,17 @@ class RobustLftAllocator:
             h_full = np.array(params.h_matrix, dtype=float)
             if h_full.shape[1] != n:
                 raise ConfigError(src, "h_matrix", h_full.shape, f"{n} columns")
-        self._b = b
-        self._params = params
         self._e = frozen(params.rho * e_shape)
         self._h = frozen(h_full)
-        self._mask = parse_mask(src, mask, n)
-        self._avail = np.flatnonzero(self._mask)
-        self._lo, self._hi = frozen(lo), frozen(hi)
-        self._lo_a, self._hi_a = lo[self._avail], hi[self._avail]
-        b_a = b[:, self._avail]
+        b_a = self._b_a
         h_a = h_full[:, self._avail]
-        self._b_a, self._h_a = b_a, h_a
-        self._range_T = range_basis_T(b_a)
-        self._attained_tol = attained_tolerance(b_a, self._lo_a, self._hi_a)
+        self._h_a = h_a
         s, u = np.linalg.eigh(self._e @ self._e.T)
         s_max = float(np.max(s)) if s.size else 0.0
         self._eig_s = np.where(s > EIG_RTOL * max(s_max, 0.0), s, 0.0)
         self._eig_u = u
         self._uncertain = s_max > 0.0 and bool(np.any(h_a != 0.0))
         k = self._avail.size
-        self._has_thrusters = k > 0
         self._eps = params.regularization * float(np.mean(np.sum(b_a * b_a, axis=0))) if k else 0.0
         self._definite = self._eps > 0.0
         self._s_max = s_max
@@ -219,36 +191,10 @@ class RobustLftAllocator:
         self._state = np.full(k, FREE, dtype=np.int8)
         self._theta_warm = math.nan
 
-    # --- introspection -----------------------------------------------------------------
-
-    @property
-    def params(self) -> RobustLftParams:
-        """The parameters this allocator was built with."""
-        return self._params
-
-    @property
-    def mask(self) -> np.ndarray:
-        """The availability mask (read-only; True = usable)."""
-        return self._mask
-
-    @property
-    def effectiveness(self) -> np.ndarray:
-        """The nominal m×n effectiveness matrix B₀ (read-only)."""
-        return self._b
-
     @property
     def lft_matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """``(E, H)`` of ``ΔB = E F H`` (read-only; ``E = ρ E_shape``)."""
         return self._e, self._h
-
-    @property
-    def bounds_N(self) -> tuple[np.ndarray, np.ndarray]:
-        """Per-thruster (lower, upper) thrust bounds [N] (read-only)."""
-        return self._lo, self._hi
-
-    def with_mask(self, mask: Sequence[bool] | np.ndarray) -> RobustLftAllocator:
-        """A new allocator for the same thrusters and uncertainty with availability ``mask``."""
-        return RobustLftAllocator(self._b, self._params, mask)
 
     def worst_case_residual(self, thrust_N: np.ndarray, demand: np.ndarray) -> float:
         """``max_{‖F‖≤1} ‖(B₀ + EFH) T − demand‖`` (exact)."""
@@ -269,15 +215,9 @@ class RobustLftAllocator:
         t, self._state = box_qp(
             self._nominal_m, self._b_a.T @ v, self._lo_a, self._hi_a, self._state, self._definite
         )
-        refined = refine_on_active_set(self._b_a, v, t, self._lo_a, self._hi_a)
-        if refined is not None:
-            r_ref, r_t = self._b_a @ refined - v, self._b_a @ t - v
-            limit = float(r_t @ r_t) * (1.0 + REFINE_RTOL) + self._attained_tol**2
-            if float(r_ref @ r_ref) <= limit:
-                return refined
-        return t
+        return refine(self._b_a, v, t, self._lo_a, self._hi_a, self._attained_tol**2)
 
-    def _solve(self, v: np.ndarray) -> np.ndarray:
+    def _robust(self, v: np.ndarray) -> np.ndarray:
         if not self._uncertain:
             return self._nominal(v)
         cv = self._eig_u.T @ v
@@ -303,10 +243,9 @@ class RobustLftAllocator:
                 w = (
                     self._c_mat.T @ (sd2 * (self._c_mat @ t - cv)) - self._hth @ t / (tau * tau)
                 )[idx]
-                try:
-                    curv -= 2.0 * float(w @ np.linalg.solve(m_mat[np.ix_(idx, idx)], w))
-                except np.linalg.LinAlgError:
-                    curv = math.nan
+                m_ff = m_mat[np.ix_(idx, idx)].tolist()
+                sol = spd_solve(m_ff, list(range(idx.size)), w.tolist(), PD_PIVOT_RTOL, RANK_RTOL)
+                curv -= 2.0 * float(w @ np.array(sol))
             # Newton decrement ψ²/ψ' estimates φ(τ) − min φ; ψ' in θ units below.
             done = curv > 0.0 and psi * psi / curv <= LFT_RTOL * obj + self._attained_tol**2
             return psi / s_max, curv / (s_max * s_max), done
@@ -320,21 +259,6 @@ class RobustLftAllocator:
         )
         return best[0][1]
 
-    def allocate(self, demand: np.ndarray) -> AllocationResult:
-        """Robust thrusts [N] for the torque/wrench ``demand`` (see the module docstring)."""
-        m, n = self._b.shape
-        d = check_demand(demand, m)
-        if not self._has_thrusters or not np.all(np.isfinite(d)):
-            return trivial_result(d, n)
-        t_a = self._solve(d)
-        thrust = np.zeros(n)
-        thrust[self._avail] = t_a
-        achieved = self._b @ thrust
-        r = d - achieved
-        in_range = self._range_T @ r
-        tol = ACTIVE_RTOL * (self._hi_a - self._lo_a)
-        active = bool(np.any((t_a <= self._lo_a + tol) | (t_a >= self._hi_a - tol)))
-        saturated = active and math.sqrt(float(in_range @ in_range)) > self._attained_tol
-        return AllocationResult(
-            frozen(thrust), frozen(achieved), math.sqrt(float(r @ r)), saturated
-        )
+    def _solve(self, d: np.ndarray) -> tuple[np.ndarray, bool | None]:
+        t_a = self._robust(d)
+        return t_a, None if bound_active(t_a, self._lo_a, self._hi_a) else False

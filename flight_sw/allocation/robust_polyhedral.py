@@ -48,7 +48,7 @@ from flight_sw.allocation.uncertainty import MAX_POLYHEDRAL_BASIS, polyhedral_ve
 class RobustPolyhedralAllocator(VertexRobustAllocator):
     """Worst-case least squares over ``B₀ + Σ δᵢ ρSᵢ``, ``|δᵢ| ≤ 1`` (seed 001, Theorem 1)."""
 
-    _kind = "RobustPolyhedralAllocator"
+    _source = "RobustPolyhedralAllocator"
 
     def __init__(
         self,
@@ -59,14 +59,9 @@ class RobustPolyhedralAllocator(VertexRobustAllocator):
     ) -> None:
         q = len(params.basis_weights) if basis is None else np.asarray(basis).shape[0]
         if q > MAX_POLYHEDRAL_BASIS:
-            raise ConfigError(self._kind, "basis", q, f"at most {MAX_POLYHEDRAL_BASIS} matrices")
+            raise ConfigError(self._source, "basis", q, f"at most {MAX_POLYHEDRAL_BASIS} matrices")
         super().__init__(effectiveness, params, mask, basis)
 
     @staticmethod
     def _vertices(b0: np.ndarray, basis: np.ndarray) -> np.ndarray:
         return polyhedral_vertices(b0, basis)
-
-    def with_mask(self, mask: Sequence[bool] | np.ndarray) -> RobustPolyhedralAllocator:
-        """A new allocator for the same thrusters and uncertainty with availability ``mask``."""
-        out: RobustPolyhedralAllocator = self._rebuild(mask)
-        return out

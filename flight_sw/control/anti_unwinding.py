@@ -37,8 +37,8 @@ import math
 
 import numpy as np
 
-from flight_sw.quaternion import cross as cross3
-from flight_sw.quaternion import skew
+from flight_sw import vec3
+from flight_sw.vec3 import Mat3, Vec3
 
 HALF = 0.5
 
@@ -90,29 +90,45 @@ def error_vector_bound(mu: float) -> float:
     return gain_terms(1.0, mu)[0]
 
 
+def error_state(e0: float, e1: float, e2: float, e3: float, w: Vec3, mu: float
+                ) -> tuple[Vec3, Mat3, Mat3]:
+    """``e_r``, ``Θ_r`` and ``Θ̇_r`` (row-major) on floats for ``q_e = (e0, e1, e2, e3)`` and
+    ``ω_e = w`` [rad/s]: the one implementation (the pose laws call it; :func:`jacobian` and
+    :func:`jacobian_rate` wrap it)."""
+    g, dg, ddg = gain_terms(e0, mu)
+    qv = (e1, e2, e3)
+    dq0 = -HALF * (e1 * w[0] + e2 * w[1] + e3 * w[2])
+    cx = vec3.cross(qv, w)
+    dqv = (HALF * (e0 * w[0] + cx[0]), HALF * (e0 * w[1] + cx[1]), HALF * (e0 * w[2] + cx[2]))
+    jac = [0.0] * 9
+    rate = [0.0] * 9
+    sk = (0.0, -e3, e2, e3, 0.0, -e1, -e2, e1, 0.0)
+    dsk = (0.0, -dqv[2], dqv[1], dqv[2], 0.0, -dqv[0], -dqv[1], dqv[0], 0.0)
+    for i in range(3):
+        for j in range(3):
+            k = 3 * i + j
+            eye = 1.0 if i == j else 0.0
+            base = e0 * eye + sk[k]
+            jac[k] = HALF * (g * base - dg * qv[i] * qv[j])
+            rate[k] = HALF * (dg * dq0 * base + g * (dq0 * eye + dsk[k])
+                              - ddg * dq0 * qv[i] * qv[j]
+                              - dg * (dqv[i] * qv[j] + qv[i] * dqv[j]))
+    return ((g * e1, g * e2, g * e3), (jac[0], jac[1], jac[2], jac[3], jac[4], jac[5], jac[6],
+            jac[7], jac[8]), (rate[0], rate[1], rate[2], rate[3], rate[4], rate[5], rate[6],
+            rate[7], rate[8]))
+
+
 def jacobian(q_e: np.ndarray, mu: float) -> np.ndarray:
     """``Θ_r`` (3×3) with ``ė_r = Θ_r ω_e`` for ``q̇_e = ½ q_e ⊗ (0, ω_e)``."""
-    q0 = float(q_e[0])
-    qv = np.asarray(q_e[1:4], dtype=float)
-    g, dg, _ = gain_terms(q0, mu)
-    return HALF * (g * (q0 * np.eye(3) + skew(qv)) - dg * np.outer(qv, qv))
+    e0, e1, e2, e3 = np.asarray(q_e, dtype=float).tolist()
+    return np.reshape(error_state(e0, e1, e2, e3, (0.0, 0.0, 0.0), mu)[1], (3, 3))
 
 
 def jacobian_rate(q_e: np.ndarray, omega_e: np.ndarray, mu: float) -> np.ndarray:
     """``Θ̇_r`` (3×3) along ``q̇_e = ½ q_e ⊗ (0, ω_e)``, ``ω_e`` [rad/s]."""
-    q0 = float(q_e[0])
-    qv = np.asarray(q_e[1:4], dtype=float)
-    w = np.asarray(omega_e, dtype=float)
-    g, dg, ddg = gain_terms(q0, mu)
-    dq0 = -HALF * float(qv @ w)
-    dqv = HALF * (q0 * w + cross3(qv, w))
-    eye = np.eye(3)
-    return HALF * (
-        dg * dq0 * (q0 * eye + skew(qv))
-        + g * (dq0 * eye + skew(dqv))
-        - ddg * dq0 * np.outer(qv, qv)
-        - dg * (np.outer(dqv, qv) + np.outer(qv, dqv))
-    )
+    e0, e1, e2, e3 = np.asarray(q_e, dtype=float).tolist()
+    w1, w2, w3 = np.asarray(omega_e, dtype=float).tolist()
+    return np.reshape(error_state(e0, e1, e2, e3, (w1, w2, w3), mu)[2], (3, 3))
 
 
 def axis_gain(q_e: np.ndarray, mu: float) -> float:

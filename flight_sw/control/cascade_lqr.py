@@ -44,14 +44,13 @@ text extraction; the structure above follows its prose and Fig. 1.
 from __future__ import annotations
 
 import math
-import numbers
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import solve_continuous_are
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.control.base import error_limit
 from flight_sw.quaternion import error_quaternion
 
@@ -64,37 +63,6 @@ SEED003_OUTER_KD = 200.0
 SEED003_INNER_KP_NMS = 15.0
 
 Triple = tuple[float, float, float]
-
-
-def _real(value: object) -> float:
-    if isinstance(value, numbers.Real) and not isinstance(value, bool):
-        return float(value)
-    return math.nan
-
-
-def _number(source: str, key: str, value: object, minimum: float, strict: bool) -> float:
-    x = _real(value)
-    if not (math.isfinite(x) and (x > minimum if strict else x >= minimum)):
-        bound = f"{'>' if strict else '>='} {minimum}"
-        raise ConfigError(source, key, value, f"a finite number {bound}")
-    return x
-
-
-def _check_max_rate(source: str, value: object) -> None:
-    if not _real(value) > 0.0:
-        raise ConfigError(source, "max_rate_rad_s", value, "a number > 0 (inf: no limit)")
-
-
-def _triple(source: str, key: str, value: object, minimum: float, strict: bool) -> Triple:
-    expected = f"3 finite numbers {'>' if strict else '>='} {minimum}"
-    items = list(value) if isinstance(value, Iterable) else []
-    if len(items) != N_AXES:
-        raise ConfigError(source, key, value, expected)
-    try:
-        x = [_number(source, key, v, minimum, strict) for v in items]
-    except ConfigError:
-        raise ConfigError(source, key, value, expected) from None
-    return x[0], x[1], x[2]
 
 
 def _principal_moments(inertia_B_kgm2: np.ndarray) -> list[float]:
@@ -138,8 +106,9 @@ class CascadeLqrParams:
     def __post_init__(self) -> None:
         src = "CascadeLqrParams"
         for key, strict in (("outer_kp_1_s", False), ("outer_kd", False), ("inner_kp_Nms", True)):
-            object.__setattr__(self, key, _triple(src, key, getattr(self, key), 0.0, strict))
-        _check_max_rate(src, self.max_rate_rad_s)
+            value = check.triple(src, key, getattr(self, key), 0.0, lo_open=strict)
+            object.__setattr__(self, key, value)
+        check.limit(src, "max_rate_rad_s", self.max_rate_rad_s, unit="rad/s")
 
     @classmethod
     def from_table1(cls, max_rate_rad_s: float = math.inf) -> CascadeLqrParams:
@@ -172,15 +141,17 @@ class CascadeLqrDesign:
 
     def __post_init__(self) -> None:
         src = "CascadeLqrDesign"
-        inner = _triple(src, "inner_kp_Nms", self.inner_kp_Nms, 0.0, True)
+        inner = check.triple(src, "inner_kp_Nms", self.inner_kp_Nms, 0.0, lo_open=True)
         object.__setattr__(self, "inner_kp_Nms", inner)
         for key, strict in (("q_angle", True), ("q_rate", False), ("r", True)):
-            object.__setattr__(self, key, _number(src, key, getattr(self, key), 0.0, strict))
-        _check_max_rate(src, self.max_rate_rad_s)
+            value = check.number(src, key, getattr(self, key), 0.0, lo_open=strict)
+            object.__setattr__(self, key, value)
+        check.limit(src, "max_rate_rad_s", self.max_rate_rad_s, unit="rad/s")
 
     def params(self, inertia_diag_kgm2: Sequence[float]) -> CascadeLqrParams:
         """The LQR gains of each axis for principal moments ``inertia_diag_kgm2`` [kg m²]."""
-        inertia = _triple("CascadeLqrDesign", "inertia_diag_kgm2", inertia_diag_kgm2, 0.0, True)
+        inertia = check.triple("CascadeLqrDesign", "inertia_diag_kgm2", inertia_diag_kgm2, 0.0,
+                               lo_open=True)
         q = np.diag([self.q_angle, self.q_rate])
         r = np.array([[self.r]])
         gains = [

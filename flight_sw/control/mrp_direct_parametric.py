@@ -49,6 +49,7 @@ from scipy.linalg import block_diag
 
 from dbc.errors import ConfigError
 from flight_sw import mrp
+from flight_sw import validation as check
 from flight_sw.quaternion import cross as cross3
 from flight_sw.quaternion import error_quaternion
 
@@ -61,23 +62,10 @@ SEED001_E_REAL_EIGENVALUES = (-3.0, -4.0, -5.0, -6.0)
 SEED001_CASE_F0_SCALE = {1: 1.0, 2: 0.5, 3: 2.0}
 # V = [Z; Z F0] is rejected as singular above this condition number.
 MAX_V_CONDITION = 1e10
-# Inertia symmetry tolerance, relative to its largest element.
-INERTIA_SYMMETRY_RTOL = 1e-9
 
 _SOURCE = "MrpDirectParametricParams"
 
 Matrix = tuple[tuple[float, ...], ...]
-
-
-def _matrix(source: str, key: str, value: object, rows: int, cols: int) -> np.ndarray:
-    expected = f"a {rows}x{cols} matrix of finite numbers"
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(source, key, value, expected) from None
-    if arr.shape != (rows, cols) or not np.all(np.isfinite(arr)):
-        raise ConfigError(source, key, value, expected)
-    return arr
 
 
 def _as_tuple(arr: np.ndarray) -> Matrix:
@@ -90,17 +78,6 @@ def seed001_e() -> np.ndarray:
         block_diag(np.array(SEED001_E_OSCILLATORY_BLOCK), *SEED001_E_REAL_EIGENVALUES),
         dtype=float,
     )
-
-
-def inertia_matrix(inertia_B_kgm2: object) -> np.ndarray:
-    """``inertia_B_kgm2`` as a validated 3×3 symmetric positive definite array [kg m²]."""
-    j = _matrix("inertia", "inertia_B_kgm2", inertia_B_kgm2, N_AXES, N_AXES)
-    scale = float(np.max(np.abs(j)))
-    if not np.allclose(j, j.T, rtol=0.0, atol=INERTIA_SYMMETRY_RTOL * scale):
-        raise ValueError(f"inertia_B_kgm2 = {j.tolist()!r}: expected a symmetric matrix")
-    if not float(np.min(np.linalg.eigvalsh(j))) > 0.0:
-        raise ValueError(f"inertia_B_kgm2 = {j.tolist()!r}: expected a positive definite matrix")
-    return 0.5 * (j + j.T)
 
 
 @dataclass(frozen=True)
@@ -116,8 +93,8 @@ class MrpDirectParametricParams:
     z: Matrix
 
     def __post_init__(self) -> None:
-        f0 = _matrix(_SOURCE, "f0", self.f0, N_STATES, N_STATES)
-        z = _matrix(_SOURCE, "z", self.z, N_AXES, N_STATES)
+        f0 = check.matrix(_SOURCE, "f0", self.f0, N_STATES, N_STATES)
+        z = check.matrix(_SOURCE, "z", self.z, N_AXES, N_STATES)
         if not float(np.max(np.linalg.eigvals(f0).real)) < 0.0:
             raise ConfigError(_SOURCE, "f0", self.f0, "a Hurwitz matrix (eigenvalues Re < 0)")
         v = np.vstack((z, z @ f0))
@@ -157,7 +134,7 @@ class MrpDirectParametric:
         # K0 ε + K1 ε̇ = H (Z F0² V⁻¹ X) + C (Z F0 V⁻¹ X), from eq. (10)–(11).
         self._zf0sq_vinv = z @ f0 @ f0 @ v_inv
         self._zf0_vinv = z @ f0 @ v_inv
-        self._inertia = inertia_matrix(inertia_B_kgm2)
+        self._inertia = check.inertia("MrpDirectParametric", "inertia_B_kgm2", inertia_B_kgm2)
 
     @property
     def params(self) -> MrpDirectParametricParams:
@@ -171,7 +148,7 @@ class MrpDirectParametric:
 
     def set_inertia_B_kgm2(self, inertia_B_kgm2: np.ndarray) -> None:
         """Use ``inertia_B_kgm2`` (3×3, symmetric positive definite) from now on."""
-        self._inertia = inertia_matrix(inertia_B_kgm2)
+        self._inertia = check.inertia("MrpDirectParametric", "inertia_B_kgm2", inertia_B_kgm2)
 
     def torque_B_Nm(
         self,

@@ -53,10 +53,12 @@ Assumptions: unit quaternions; the nominal model is ``mass_kg`` and ``inertia_B_
 error, where its scalar part is floored at ``ETA_FLOOR`` (bounded but large output);
 the branch ``S̄_i = 0`` of eqs. (14)–(19) is taken only on exact equality.
 
-Implementation: :meth:`NftsmDq.wrench_B` evaluates the law on floats (a few µs compiled);
-:meth:`NftsmDq.wrench_B_reference` composes it from this module's array functions
-(:func:`relative_motion`, :func:`attitude_state`, :func:`drift_wrench`, ... which the TSM
-baseline shares), term by term as the paper writes it; tests hold the two equal to round-off.
+Implementation: :meth:`NftsmDq.wrench_B` evaluates the law on floats (a few µs compiled):
+the surface-independent parts (error state, kinematics, drift, wrench assembly) are
+:mod:`flight_sw.control.dq_error_state`'s, shared with the TSM baseline; this module adds
+the NFTSM surface (eqs. 13–16, 18–19) and the bracket of law (17). The parameters are
+:class:`flight_sw.control.nftsm_dq_params.NftsmDqParams`. The tests hold the law to the
+paper's terms composed as arrays (``tests/flight_sw/control/dq_reference.py``).
 
 Source: seed 000, eqs. (6)–(19), (24)–(26), Section V (gains: p1 = 0.6, p2 = 0.67,
 δ̂ = 0.05 + ϵ 0.001, K̂ = 20 + ϵ 20, α̂1 = α̂2 = 0.05 + ϵ 0.1, α̂3 = 2 + ϵ 2, m0 = 100 kg,
@@ -66,213 +68,37 @@ J0 = diag(18, 18, 24) kg m², leader orbit 42,240 km); Filipe & Tsiotras 2015 (J
 
 from __future__ import annotations
 
-import math
-import numbers
-from collections.abc import Iterable
-from dataclasses import dataclass
-from typing import NamedTuple
-
 import numpy as np
-from mypy_extensions import mypyc_attr
 
-from dbc.errors import ConfigError
-from flight_sw import dual_quaternion as dq
-from flight_sw.control import anti_unwinding as au
-from flight_sw.quaternion import cross as cross3
-from flight_sw.quaternion import error_quaternion, to_dcm
+from flight_sw import vec3
+from flight_sw.control import dq_error_state as es
+from flight_sw.control.dq_error_state import (
+    ETA_FLOOR,
+    MU_EARTH_M3_S2,
+    PAPER_MEAN_MOTION_RAD_S,
+    PAPER_ORBIT_RADIUS_M,
+)
+from flight_sw.control.nftsm_dq_params import (
+    DEFAULT_ANTI_UNWINDING_MU,
+    DEFAULT_SWITCHING_WIDTH,
+    N_AXES,
+    NftsmDqParams,
+    validate_inertia,
+)
 
-N_AXES = 3
-HALF = 0.5
-# Earth's gravitational parameter [m³/s²] (EGM/WGS-84 value).
-MU_EARTH_M3_S2 = 3.986004418e14
-# The leader's orbit radius of seed 000, Section V [m], and its mean motion [rad/s].
-PAPER_ORBIT_RADIUS_M = 42_240e3
-PAPER_MEAN_MOTION_RAD_S = math.sqrt(MU_EARTH_M3_S2 / PAPER_ORBIT_RADIUS_M**3)
-# Floor of the scalar part q_e0 in Θ̂ (its inverse is singular at a 180° error).
-ETA_FLOOR = 1e-3
-# Default width w of tanh(S/w) replacing sgn(S) (the paper gives no value).
-DEFAULT_SWITCHING_WIDTH = 0.05
-# Default µ of the anti-unwinding error vector (the paper gives no value); with it Θ_r is
-# singular at 103.1° (0.1: 99.1°, beyond the paper's initial 102.7°, which then diverges).
-DEFAULT_ANTI_UNWINDING_MU = 0.01
-
-_SOURCE = "NftsmDqParams"
-
-
-def _is_real(value: object) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def three_positive(source: str, key: str, value: object) -> tuple[float, float, float]:
-    """Validate three finite numbers > 0 (a per-axis gain); ConfigError naming ``key``."""
-    expected = "3 finite numbers > 0"
-    if not isinstance(value, Iterable):
-        raise ConfigError(source, key, value, expected)
-    out: list[float] = []
-    for v in value:
-        if not (_is_real(v) and math.isfinite(float(v)) and float(v) > 0.0):
-            raise ConfigError(source, key, value, expected)
-        out.append(float(v))
-    if len(out) != N_AXES:
-        raise ConfigError(source, key, value, expected)
-    return out[0], out[1], out[2]
-
-
-def real_in(source: str, key: str, value: object, lo: float, hi: float, expected: str) -> float:
-    """Validate one number in the open interval (lo, hi) (``inf`` allowed as ``hi``)."""
-    if not (_is_real(value) and lo < float(value) < hi):  # type: ignore[arg-type]
-        raise ConfigError(source, key, value, expected)
-    return float(value)  # type: ignore[arg-type]
-
-
-def validate_limit(source: str, key: str, value: object) -> float:
-    """Validate an output limit: a number > 0, ``inf`` for none."""
-    if not (_is_real(value) and float(value) > 0.0):  # type: ignore[arg-type]
-        raise ConfigError(source, key, value, "a number > 0 (inf: no limit)")
-    return float(value)  # type: ignore[arg-type]
-
-
-def validate_orbit(source: str, mean_motion: object, mu: object) -> tuple[float, float]:
-    """Validate the mean motion (finite, ≥ 0) [rad/s] and µ (finite, > 0) [m³/s²]."""
-    if not (_is_real(mean_motion) and 0.0 <= float(mean_motion) < math.inf):  # type: ignore[arg-type]
-        raise ConfigError(source, "mean_motion_rad_s", mean_motion, "a finite number >= 0")
-    mu_f = real_in(source, "mu_m3_s2", mu, 0.0, math.inf, "a finite number > 0")
-    return float(mean_motion), mu_f  # type: ignore[arg-type]
-
-
-def validate_inertia(inertia: object) -> np.ndarray:
-    """A 3×3 symmetric positive-definite inertia [kg m²] (or 3 principal moments)."""
-    arr = np.asarray(inertia, dtype=float)
-    if arr.shape == (N_AXES,):
-        arr = np.diag(arr)
-    if arr.shape != (N_AXES, N_AXES) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"inertia_B_kgm2 = {inertia!r}: expected a finite 3×3 matrix")
-    if not np.allclose(arr, arr.T) or np.linalg.eigvalsh(arr).min() <= 0.0:
-        raise ValueError(f"inertia_B_kgm2 = {inertia!r}: expected symmetric positive-definite")
-    return arr
-
-
-def sig(x: np.ndarray, power: float) -> np.ndarray:
-    """``sig(x)^a = sgn(x) |x|^a`` element-wise."""
-    return np.sign(x) * np.abs(x) ** power
-
-
-def clip_norm(v: np.ndarray, limit: float) -> np.ndarray:
-    """``v`` scaled down to norm ``limit`` if longer (direction preserved)."""
-    norm = float(np.linalg.norm(v))
-    return v * (limit / norm) if norm > limit else v
-
-
-class RelativeMotion(NamedTuple):
-    """The dual-quaternion error state of B relative to the desired frame D (= R).
-
-    ``dq_e`` error dual quaternion (8,), short way; ``twist_e`` ``ω̂_e`` (6,) [rad/s; m/s];
-    ``twist_B`` the inertial twist ``ω̂`` of B in B axes (6,); ``twist_d_B`` ``q̂_e* ∘ ω̂_d ∘
-    q̂_e`` (6,); ``dtwist_d_B`` ``q̂_e* ∘ ω̂̇_d ∘ q̂_e`` (6,); ``gravity_B_m_s2`` the nominal
-    gravitational acceleration of B in B axes (3,).
-    """
-
-    dq_e: np.ndarray
-    twist_e: np.ndarray
-    twist_B: np.ndarray
-    twist_d_B: np.ndarray
-    dtwist_d_B: np.ndarray
-    gravity_B_m_s2: np.ndarray
-
-
-def relative_motion(
-    q_BN: np.ndarray,
-    omega_BN_B: np.ndarray,
-    r_N_m: np.ndarray,
-    v_N_m_s: np.ndarray,
-    q_RN: np.ndarray,
-    omega_RN_B: np.ndarray,
-    r_ref_N_m: np.ndarray,
-    v_ref_N_m_s: np.ndarray,
-    mean_motion_rad_s: float,
-    mu_m3_s2: float,
-) -> RelativeMotion:
-    """The error state of eqs. (6)–(7) from the PoseController inputs (see module docstring)."""
-    r = np.asarray(r_N_m, dtype=float)
-    v = np.asarray(v_N_m_s, dtype=float)
-    r_ref = np.asarray(r_ref_N_m, dtype=float)
-    v_ref = np.asarray(v_ref_N_m_s, dtype=float)
-    C_BN = to_dcm(q_BN)
-    q_BR = error_quaternion(q_RN, q_BN)
-    C_BR = to_dcm(q_BR)
-    C_RN = to_dcm(q_RN)
-    n = mean_motion_rad_s
-    omega_NI_N = np.array([0.0, 0.0, n])
-    if n > 0.0:
-        radius = (mu_m3_s2 / (n * n)) ** (1.0 / 3.0)
-        leader_pos_N = np.array([radius, 0.0, 0.0])
-        leader_vel_N = np.array([0.0, n * radius, 0.0])
-        pos_N = leader_pos_N + r
-        gravity_N = -mu_m3_s2 * pos_N / float(np.linalg.norm(pos_N)) ** 3
-    else:
-        leader_pos_N = np.zeros(3)
-        leader_vel_N = np.zeros(3)
-        gravity_N = np.zeros(3)
-
-    # inertial twists: B at its origin in B axes; D (= R) at its origin in R axes
-    omega_B = np.asarray(omega_BN_B, dtype=float) + C_BN @ omega_NI_N
-    vel_B = C_BN @ (v + leader_vel_N + cross3(omega_NI_N, r))
-    twist_B = np.concatenate((omega_B, vel_B))
-    omega_RN_R = C_BR.T @ np.asarray(omega_RN_B, dtype=float)
-    omega_d = C_RN @ omega_NI_N + omega_RN_R
-    vel_d = C_RN @ (v_ref + leader_vel_N + cross3(omega_NI_N, r_ref))
-    # derivatives of the R-axes components (ω_RN constant in R, v_ref constant in N)
-    domega_d = -cross3(omega_RN_R, C_RN @ omega_NI_N)
-    dvel_d = -cross3(omega_RN_R, vel_d) + C_RN @ cross3(omega_NI_N, v_ref)
-
-    dq_e = dq.short_way(dq.from_pose(q_BR, C_BN @ (r - r_ref)))
-    twist_d_B = dq.transform_twist(dq_e, np.concatenate((omega_d, vel_d)))
-    dtwist_d_B = dq.transform_twist(dq_e, np.concatenate((domega_d, dvel_d)))
-    return RelativeMotion(
-        dq_e=dq_e,
-        twist_e=twist_B - twist_d_B,
-        twist_B=twist_B,
-        twist_d_B=twist_d_B,
-        dtwist_d_B=dtwist_d_B,
-        gravity_B_m_s2=C_BN @ gravity_N,
-    )
-
-
-def apply_mass(mass_kg: float, inertia_B_kgm2: np.ndarray, twist: np.ndarray) -> np.ndarray:
-    """``M̂ (ω + ϵ v) = m v + ϵ J ω``: twist-shaped (6,) -> wrench-shaped (6,) [force; torque]."""
-    return np.concatenate((mass_kg * twist[3:], inertia_B_kgm2 @ twist[:3]))
-
-
-def drift_wrench(motion: RelativeMotion, mass_kg: float, inertia_B_kgm2: np.ndarray) -> np.ndarray:
-    """``F̂`` of the nominal error dynamics ``M̂0 ω̂̇_e = û_c + F̂`` (eq. 8 plus gravity), (6,)."""
-    w_e, w, w_d = motion.twist_e, motion.twist_B, motion.twist_d_B
-    feed = dq.cross(w_e, w_d) - motion.dtwist_d_B
-    gyro = dq.cross(w, apply_mass(mass_kg, inertia_B_kgm2, w))
-    gravity = np.concatenate((mass_kg * motion.gravity_B_m_s2, np.zeros(3)))
-    return apply_mass(mass_kg, inertia_B_kgm2, feed) - gyro + gravity
-
-
-def attitude_state(
-    motion: RelativeMotion, anti_unwinding: bool, mu: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``ξ̂`` (6,), ``Θ̂`` (6×6) and ``Θ̂̇`` (6×6) of eq. (10); attitude part per eq. (26) if asked."""
-    dq_e = motion.dq_e.copy()
-    dq_e[0] = max(dq_e[0], ETA_FLOOR)
-    xi = dq.vector_part(dq_e)
-    theta = dq.kinematics_matrix(dq_e)
-    theta_dot = dq.kinematics_matrix_rate(dq_e, motion.twist_e)
-    if anti_unwinding:
-        q_e = motion.dq_e[:4]
-        xi[:3] = au.error_vector(q_e, mu)
-        theta[:3, :3] = au.jacobian(q_e, mu)
-        theta_dot[:3, :3] = au.jacobian_rate(q_e, motion.twist_e[:3], mu)
-    return xi, theta, theta_dot
-
-
-def robust_wrench(k_att: np.ndarray, k_pos: np.ndarray, s: np.ndarray, width: float) -> np.ndarray:
-    """``K̂ ⊙ tanh(Ŝ/w)`` in wrench slots: position surface -> force, attitude -> torque."""
-    t = np.tanh(s / width)
-    return np.concatenate((k_pos * t[3:], k_att * t[:3]))
+__all__ = [
+    "DEFAULT_ANTI_UNWINDING_MU",
+    "DEFAULT_SWITCHING_WIDTH",
+    "ETA_FLOOR",
+    "MU_EARTH_M3_S2",
+    "PAPER_MEAN_MOTION_RAD_S",
+    "PAPER_ORBIT_RADIUS_M",
+    "NftsmDq",
+    "NftsmDqParams",
+    "auxiliary_surface",
+    "auxiliary_surface_f",
+    "sig_vec",
+]
 
 
 def auxiliary_surface(
@@ -327,7 +153,7 @@ def _floats(v: np.ndarray | float, n: int) -> list[float]:
 
 
 def _sig1(x: float, abs_x: float, power: float) -> float:
-    """``sig(x)^a`` of one float (as :func:`sig`: 0 at 0)."""
+    """``sig(x)^a = sgn(x) |x|^a`` of one float (0 at 0); ``abs_x = |x|``."""
     if x > 0.0:
         return abs_x**power
     if x < 0.0:
@@ -335,191 +161,13 @@ def _sig1(x: float, abs_x: float, power: float) -> float:
     return 0.0 * x
 
 
-Vec = tuple[float, float, float]
-Mat3 = tuple[float, float, float, float, float, float, float, float, float]  # row-major
-
-
-def _dcm(q0: float, q1: float, q2: float, q3: float) -> Mat3:
-    """``C(q)`` row-major, as :func:`flight_sw.quaternion.to_dcm`."""
-    q00, q11, q22, q33 = q0 * q0, q1 * q1, q2 * q2, q3 * q3
-    q01, q02, q03 = q0 * q1, q0 * q2, q0 * q3
-    q12, q13, q23 = q1 * q2, q1 * q3, q2 * q3
-    return (q00 + q11 - q22 - q33, 2.0 * (q12 + q03), 2.0 * (q13 - q02),
-            2.0 * (q12 - q03), q00 - q11 + q22 - q33, 2.0 * (q23 + q01),
-            2.0 * (q13 + q02), 2.0 * (q23 - q01), q00 - q11 - q22 + q33)
-
-
-def _mv(m: Mat3, x: float, y: float, z: float) -> Vec:
-    """``M v``."""
-    return (m[0] * x + m[1] * y + m[2] * z, m[3] * x + m[4] * y + m[5] * z,
-            m[6] * x + m[7] * y + m[8] * z)
-
-
-def _mtv(m: Mat3, x: float, y: float, z: float) -> Vec:
-    """``Mᵀ v``."""
-    return (m[0] * x + m[3] * y + m[6] * z, m[1] * x + m[4] * y + m[7] * z,
-            m[2] * x + m[5] * y + m[8] * z)
-
-
-def _cross(a: Vec, b: Vec) -> Vec:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _theta_blocks(e0: float, e1: float, e2: float, e3: float, d0: float, d1: float,
-                  d2: float, d3: float) -> tuple[Mat3, Mat3]:
-    """The blocks Θ, Θ′ of :func:`flight_sw.dual_quaternion.kinematics_matrix`."""
-    q0, q1, q2, q3 = HALF * e0, HALF * e1, HALF * e2, HALF * e3
-    p0, p1, p2, p3 = HALF * d0, HALF * d1, HALF * d2, HALF * d3
-    return ((q0, -q3, q2, q3, q0, -q1, -q2, q1, q0),
-            (p0, -p3, p2, p3, p0, -p1, -p2, p1, p0))
-
-
-def _au_blocks(e0: float, e1: float, e2: float, e3: float, w: Vec, mu: float
-               ) -> tuple[Vec, Mat3, Mat3]:
-    """Anti-unwinding ``e_r``, ``Θ_r`` and ``Θ̇_r`` (:mod:`flight_sw.control.anti_unwinding`)."""
-    g, dg, ddg = au.gain_terms(e0, mu)
-    qv = (e1, e2, e3)
-    dq0 = -HALF * (e1 * w[0] + e2 * w[1] + e3 * w[2])
-    cx = _cross(qv, w)
-    dqv = (HALF * (e0 * w[0] + cx[0]), HALF * (e0 * w[1] + cx[1]), HALF * (e0 * w[2] + cx[2]))
-    jac = [0.0] * 9
-    rate = [0.0] * 9
-    sk = (0.0, -e3, e2, e3, 0.0, -e1, -e2, e1, 0.0)
-    dsk = (0.0, -dqv[2], dqv[1], dqv[2], 0.0, -dqv[0], -dqv[1], dqv[0], 0.0)
-    for i in range(3):
-        for j in range(3):
-            k = 3 * i + j
-            eye = 1.0 if i == j else 0.0
-            base = e0 * eye + sk[k]
-            jac[k] = HALF * (g * base - dg * qv[i] * qv[j])
-            rate[k] = HALF * (dg * dq0 * base + g * (dq0 * eye + dsk[k])
-                              - ddg * dq0 * qv[i] * qv[j]
-                              - dg * (dqv[i] * qv[j] + qv[i] * dqv[j]))
-    return ((g * e1, g * e2, g * e3), (jac[0], jac[1], jac[2], jac[3], jac[4], jac[5], jac[6],
-            jac[7], jac[8]), (rate[0], rate[1], rate[2], rate[3], rate[4], rate[5], rate[6],
-            rate[7], rate[8]))
-
-
-def _solve3(m: Mat3, b: Vec) -> Vec:
-    """``M⁻¹ b`` by the adjugate (Cramer's rule); M non-singular."""
-    c0 = m[4] * m[8] - m[5] * m[7]
-    c1 = m[5] * m[6] - m[3] * m[8]
-    c2 = m[3] * m[7] - m[4] * m[6]
-    inv_det = 1.0 / (m[0] * c0 + m[1] * c1 + m[2] * c2)
-    return (
-        (c0 * b[0] + (m[2] * m[7] - m[1] * m[8]) * b[1] + (m[1] * m[5] - m[2] * m[4]) * b[2])
-        * inv_det,
-        (c1 * b[0] + (m[0] * m[8] - m[2] * m[6]) * b[1] + (m[2] * m[3] - m[0] * m[5]) * b[2])
-        * inv_det,
-        (c2 * b[0] + (m[1] * m[6] - m[0] * m[7]) * b[1] + (m[0] * m[4] - m[1] * m[3]) * b[2])
-        * inv_det,
-    )
-
-
-def _dq_mul(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, ...]:
-    return dq._mul(a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7],
-                   b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7])
-
-
-def _transform(e: tuple[float, ...], w: Vec, v: Vec) -> tuple[Vec, Vec]:
-    """:func:`flight_sw.dual_quaternion.transform_twist` on floats: (angular, linear)."""
-    conj = (e[0], -e[1], -e[2], -e[3], e[4], -e[5], -e[6], -e[7])
-    out = _dq_mul(_dq_mul(conj, (0.0, w[0], w[1], w[2], 0.0, v[0], v[1], v[2])), e)
-    return (out[1], out[2], out[3]), (out[5], out[6], out[7])
-
-
-def _mat3(m: np.ndarray) -> Mat3:
-    """A 3×3 array as a row-major tuple."""
-    a = m.reshape(-1).tolist()
-    return (a[0], a[1], a[2], a[3], a[4], a[5], a[6], a[7], a[8])
-
-
-def _clip(x: float, y: float, z: float, limit: float) -> Vec:
-    norm = math.sqrt(x * x + y * y + z * z)
-    if norm > limit:
-        k = limit / norm
-        return (x * k, y * k, z * k)
-    return (x, y, z)
-
-
-def _sig_vec(v: list[float], power: float) -> list[float]:
+def sig_vec(v: list[float], power: float) -> list[float]:
+    """``sig(v)^a`` element-wise on floats (0 at 0)."""
     return [_sig1(x, abs(x), power) for x in v]
 
 
-@mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
-@dataclass(frozen=True)
-class NftsmDqParams:
-    """Gains and nominal model of the NFTSM law; defaults are seed 000, Section V.
-
-    Attributes (``_att``: real part, attitude, 3 body axes; ``_pos``: dual part, position):
-        mass_kg: nominal mass m0 [kg] (> 0).
-        inertia_B_kgm2: nominal principal moments J0 [kg m²] (3 numbers > 0).
-        alpha1_att, alpha1_pos: α̂1 of eq. (13) [1/s].
-        alpha2_att, alpha2_pos: α̂2 of eq. (13) [1/s].
-        alpha3_att, alpha3_pos: α̂3 of eq. (17) (reaching gain).
-        k_att_Nm: K, torque gain of the attitude surface [N m]; k_pos_N: K′ [N].
-        p1: exponent of the auxiliary surface, in (0.5, 1); p2: reaching exponent, (0, 1).
-        delta_att, delta_pos: δ, δ′ switching thresholds of eqs. (14)–(15) (> 0).
-        switching_width: w of tanh(S/w) replacing sgn(S) (> 0).
-        mean_motion_rad_s: n of the leader's circular orbit (0: N inertial, no gravity).
-        mu_m3_s2: gravitational parameter [m³/s²].
-        anti_unwinding: use e_r of eq. (26) as the attitude state.
-        anti_unwinding_mu: µ of eqs. (25)–(26) (> 0).
-        max_force_N, max_torque_Nm: optional output norm limits (inf: unbounded).
-    """
-
-    mass_kg: float = 100.0
-    inertia_B_kgm2: tuple[float, float, float] = (18.0, 18.0, 24.0)
-    alpha1_att: tuple[float, float, float] = (0.05, 0.05, 0.05)
-    alpha1_pos: tuple[float, float, float] = (0.1, 0.1, 0.1)
-    alpha2_att: tuple[float, float, float] = (0.05, 0.05, 0.05)
-    alpha2_pos: tuple[float, float, float] = (0.1, 0.1, 0.1)
-    alpha3_att: tuple[float, float, float] = (2.0, 2.0, 2.0)
-    alpha3_pos: tuple[float, float, float] = (2.0, 2.0, 2.0)
-    k_att_Nm: tuple[float, float, float] = (20.0, 20.0, 20.0)
-    k_pos_N: tuple[float, float, float] = (20.0, 20.0, 20.0)
-    p1: float = 0.6
-    p2: float = 0.67
-    delta_att: float = 0.05
-    delta_pos: float = 0.001
-    switching_width: float = DEFAULT_SWITCHING_WIDTH
-    mean_motion_rad_s: float = 0.0
-    mu_m3_s2: float = MU_EARTH_M3_S2
-    anti_unwinding: bool = False
-    anti_unwinding_mu: float = DEFAULT_ANTI_UNWINDING_MU
-    max_force_N: float = math.inf
-    max_torque_Nm: float = math.inf
-
-    def __post_init__(self) -> None:
-        s = _SOURCE
-        real_in(s, "mass_kg", self.mass_kg, 0.0, math.inf, "a finite number > 0")
-        object.__setattr__(
-            self, "inertia_B_kgm2", three_positive(s, "inertia_B_kgm2", self.inertia_B_kgm2)
-        )
-        for key in (
-            "alpha1_att",
-            "alpha1_pos",
-            "alpha2_att",
-            "alpha2_pos",
-            "alpha3_att",
-            "alpha3_pos",
-            "k_att_Nm",
-            "k_pos_N",
-        ):
-            object.__setattr__(self, key, three_positive(s, key, getattr(self, key)))
-        real_in(s, "p1", self.p1, 0.5, 1.0, "a number in (0.5, 1)")
-        real_in(s, "p2", self.p2, 0.0, 1.0, "a number in (0, 1)")
-        for key in ("delta_att", "delta_pos", "switching_width", "anti_unwinding_mu"):
-            real_in(s, key, getattr(self, key), 0.0, math.inf, "a finite number > 0")
-        validate_orbit(s, self.mean_motion_rad_s, self.mu_m3_s2)
-        if not isinstance(self.anti_unwinding, bool):
-            raise ConfigError(s, "anti_unwinding", self.anti_unwinding, "true or false")
-        validate_limit(s, "max_force_N", self.max_force_N)
-        validate_limit(s, "max_torque_Nm", self.max_torque_Nm)
-
-
-def _dual_gain(att: tuple[float, float, float], pos: tuple[float, float, float]) -> np.ndarray:
-    return np.array(att + pos, dtype=float)
+def _dual_gain(att: tuple[float, float, float], pos: tuple[float, float, float]) -> list[float]:
+    return [float(x) for x in att + pos]
 
 
 class NftsmDq:
@@ -535,17 +183,10 @@ class NftsmDq:
         self._alpha1 = _dual_gain(p.alpha1_att, p.alpha1_pos)
         self._alpha2 = _dual_gain(p.alpha2_att, p.alpha2_pos)
         self._alpha3 = _dual_gain(p.alpha3_att, p.alpha3_pos)
-        self._k_att = np.array(p.k_att_Nm, dtype=float)
-        self._k_pos = np.array(p.k_pos_N, dtype=float)
-        self._delta = np.array([p.delta_att] * N_AXES + [p.delta_pos] * N_AXES)
-        # the same as floats, for wrench_B
-        self._alpha1_f: list[float] = self._alpha1.tolist()
-        self._alpha2_f: list[float] = self._alpha2.tolist()
-        self._alpha3_f: list[float] = self._alpha3.tolist()
-        self._k_att_f: list[float] = self._k_att.tolist()
-        self._k_pos_f: list[float] = self._k_pos.tolist()
-        self._delta_f: list[float] = self._delta.tolist()
-        self._inertia_f = _mat3(self._inertia)
+        self._k_att = [float(x) for x in p.k_att_Nm]
+        self._k_pos = [float(x) for x in p.k_pos_N]
+        self._delta = [float(p.delta_att)] * N_AXES + [float(p.delta_pos)] * N_AXES
+        self._inertia_f = vec3.mat3(self._inertia)
 
     @property
     def params(self) -> NftsmDqParams:
@@ -560,14 +201,20 @@ class NftsmDq:
     def set_inertia_B_kgm2(self, inertia_B_kgm2: np.ndarray) -> None:
         """Use ``inertia_B_kgm2`` (3×3 SPD, or 3 principal moments) [kg m²] from now on."""
         self._inertia = validate_inertia(inertia_B_kgm2)
-        self._inertia_f = _mat3(self._inertia)
+        self._inertia_f = vec3.mat3(self._inertia)
+
+    def _surface(self, xi: list[float], xi_dot: list[float]) -> tuple[list[float], list[float]]:
+        """``Ŝ = ξ̂̇ + α̂1 ⊙ ξ̂ + α̂2 ⊙ Ŝ_a`` (eq. 13) and ``W ⊙ ξ̂̇`` (eqs. 18–19)."""
+        a1 = self._alpha1
+        a2 = self._alpha2
+        s_a, w_xd = auxiliary_surface_f(xi, xi_dot, a1, a2, self._params.p1, self._delta)
+        return [xi_dot[i] + a1[i] * xi[i] + a2[i] * s_a[i] for i in range(6)], w_xd
 
     def surface(self, xi: np.ndarray, xi_dot: np.ndarray) -> np.ndarray:
         """``Ŝ = ξ̂̇ + α̂1 ⊙ ξ̂ + α̂2 ⊙ Ŝ_a`` (eq. 13), (6,)."""
-        s_a, _ = auxiliary_surface(
-            xi, xi_dot, self._alpha1, self._alpha2, self._params.p1, self._delta
-        )
-        return np.asarray(xi_dot + self._alpha1 * xi + self._alpha2 * s_a)
+        s, _ = self._surface(np.asarray(xi, dtype=float).tolist(),
+                             np.asarray(xi_dot, dtype=float).tolist())
+        return np.array(s)
 
     def wrench_B(
         self,
@@ -583,175 +230,22 @@ class NftsmDq:
     ) -> np.ndarray:
         """Law (17): the demanded wrench [force_B_N; torque_B_Nm], shape (6,).
 
-        Evaluated on floats, equal to :meth:`wrench_B_reference` up to round-off
-        (``tests/flight_sw/control/test_nftsm_dq.py``): the same steps (module docstring)
-        without one array per 3- or 6-vector; Θ̂ is block lower triangular, so its inverse
-        is two 3×3 solves.
+        ``ω̂̇* = −Θ̂⁻¹ [Θ̂̇ ω̂_e + α̂1 ⊙ ξ̂̇ + α̂2 ⊙ W ⊙ ξ̂̇ + α̂3 ⊙ sig(Ŝ)^p2]``, then
+        ``û_c = M̂0 ω̂̇* − F̂ − K̂ ⊙ tanh(Ŝ/w)`` (module docstring).
         """
         p = self._params
-        b0, b1, b2, b3 = np.asarray(q_BN, dtype=float).tolist()
-        w_bn = np.asarray(omega_BN_B, dtype=float).tolist()
-        r = np.asarray(r_N_m, dtype=float).tolist()
-        v = np.asarray(v_N_m_s, dtype=float).tolist()
-        n0, n1, n2, n3 = np.asarray(q_RN, dtype=float).tolist()
-        w_rn = np.asarray(omega_RN_B, dtype=float).tolist()
-        r_ref = np.asarray(r_ref_N_m, dtype=float).tolist()
-        v_ref = np.asarray(v_ref_N_m_s, dtype=float).tolist()
-        # relative motion (eqs. 6-7; relative_motion)
-        c_bn = _dcm(b0, b1, b2, b3)
-        qe = dq._mul(n0, -n1, -n2, -n3, 0.0, 0.0, 0.0, 0.0, b0, b1, b2, b3, 0.0, 0.0, 0.0, 0.0)
-        c_br = _dcm(qe[0], qe[1], qe[2], qe[3])
-        c_rn = _dcm(n0, n1, n2, n3)
-        n = p.mean_motion_rad_s
-        w_ni: Vec = (0.0, 0.0, n)
-        lead_v: Vec = (0.0, 0.0, 0.0)
-        grav: Vec = (0.0, 0.0, 0.0)
-        if n > 0.0:
-            radius = (p.mu_m3_s2 / (n * n)) ** (1.0 / 3.0)
-            lead_v = (0.0, n * radius, 0.0)
-            px, py, pz = radius + r[0], r[1], r[2]
-            k = -p.mu_m3_s2 / math.sqrt(px * px + py * py + pz * pz) ** 3
-            grav = (k * px, k * py, k * pz)
-        w_ni_b = _mv(c_bn, w_ni[0], w_ni[1], w_ni[2])
-        om_b: Vec = (w_bn[0] + w_ni_b[0], w_bn[1] + w_ni_b[1], w_bn[2] + w_ni_b[2])
-        cr = _cross(w_ni, (r[0], r[1], r[2]))
-        vel_b = _mv(c_bn, v[0] + lead_v[0] + cr[0], v[1] + lead_v[1] + cr[1],
-                    v[2] + lead_v[2] + cr[2])
-        om_rn_r = _mtv(c_br, w_rn[0], w_rn[1], w_rn[2])
-        w_ni_r = _mv(c_rn, w_ni[0], w_ni[1], w_ni[2])
-        om_d: Vec = (w_ni_r[0] + om_rn_r[0], w_ni_r[1] + om_rn_r[1], w_ni_r[2] + om_rn_r[2])
-        cr = _cross(w_ni, (r_ref[0], r_ref[1], r_ref[2]))
-        vel_d = _mv(c_rn, v_ref[0] + lead_v[0] + cr[0], v_ref[1] + lead_v[1] + cr[1],
-                    v_ref[2] + lead_v[2] + cr[2])
-        dom = _cross(om_rn_r, w_ni_r)
-        dom_d: Vec = (-dom[0], -dom[1], -dom[2])
-        cv = _cross(om_rn_r, vel_d)
-        cr = _cross(w_ni, (v_ref[0], v_ref[1], v_ref[2]))
-        cn = _mv(c_rn, cr[0], cr[1], cr[2])
-        dvel_d: Vec = (-cv[0] + cn[0], -cv[1] + cn[1], -cv[2] + cn[2])
-        pe = _mv(c_bn, r[0] - r_ref[0], r[1] - r_ref[1], r[2] - r_ref[2])
-        half = dq._mul(qe[0], qe[1], qe[2], qe[3], 0.0, 0.0, 0.0, 0.0,
-                       0.0, pe[0], pe[1], pe[2], 0.0, 0.0, 0.0, 0.0)
-        e: tuple[float, ...] = (qe[0], qe[1], qe[2], qe[3], HALF * half[0], HALF * half[1],
-                                HALF * half[2], HALF * half[3])
-        if e[0] < 0.0:
-            e = tuple(-x for x in e)
-        wd, vd = _transform(e, om_d, vel_d)
-        dwd, dvd = _transform(e, dom_d, dvel_d)
-        nu = [om_b[0] - wd[0], om_b[1] - wd[1], om_b[2] - wd[2],
-              vel_b[0] - vd[0], vel_b[1] - vd[1], vel_b[2] - vd[2]]
-        # attitude state (eq. 10; attitude_state), Θ̂ = [[th, 0], [thd, th]]
-        f0 = max(e[0], ETA_FLOOR)
-        th, thd = _theta_blocks(f0, e[1], e[2], e[3], e[4], e[5], e[6], e[7])
-        de = dq._mul(f0, e[1], e[2], e[3], e[4], e[5], e[6], e[7],
-                     0.0, nu[0], nu[1], nu[2], 0.0, nu[3], nu[4], nu[5])
-        th_dot, thd_dot = _theta_blocks(HALF * de[0], HALF * de[1], HALF * de[2],
-                                        HALF * de[3], HALF * de[4], HALF * de[5],
-                                        HALF * de[6], HALF * de[7])
-        xi = [e[1], e[2], e[3], e[5], e[6], e[7]]
-        th_r = th
-        th_r_dot = th_dot
-        if p.anti_unwinding:
-            er, th_r, th_r_dot = _au_blocks(e[0], e[1], e[2], e[3], (nu[0], nu[1], nu[2]),
-                                            p.anti_unwinding_mu)
-            xi[0], xi[1], xi[2] = er
-        nu_w: Vec = (nu[0], nu[1], nu[2])
-        nu_v: Vec = (nu[3], nu[4], nu[5])
-        x_r = _mv(th_r, nu[0], nu[1], nu[2])
-        x_d1 = _mv(thd, nu[0], nu[1], nu[2])
-        x_d2 = _mv(th, nu[3], nu[4], nu[5])
-        xi_dot = [x_r[0], x_r[1], x_r[2], x_d1[0] + x_d2[0], x_d1[1] + x_d2[1],
-                  x_d1[2] + x_d2[2]]
-        # surfaces (eqs. 13-19) and the bracket of law (17)
-        a1 = self._alpha1_f
-        a2 = self._alpha2_f
-        a3 = self._alpha3_f
-        s_a, w_xd = auxiliary_surface_f(xi, xi_dot, a1, a2, p.p1, self._delta_f)
-        s_sl = [xi_dot[i] + a1[i] * xi[i] + a2[i] * s_a[i] for i in range(6)]
-        sp = _sig_vec(s_sl, p.p2)
-        t_r = _mv(th_r_dot, nu_w[0], nu_w[1], nu_w[2])
-        t_d1 = _mv(thd_dot, nu_w[0], nu_w[1], nu_w[2])
-        t_d2 = _mv(th_dot, nu_v[0], nu_v[1], nu_v[2])
-        tdot_nu = [t_r[0], t_r[1], t_r[2], t_d1[0] + t_d2[0], t_d1[1] + t_d2[1],
-                   t_d1[2] + t_d2[2]]
+        st = es.error_state(q_BN, omega_BN_B, r_N_m, v_N_m_s, q_RN, omega_RN_B, r_ref_N_m,
+                            v_ref_N_m_s, p.mean_motion_rad_s, p.mu_m3_s2, p.anti_unwinding,
+                            p.anti_unwinding_mu)
+        xi_dot = st.xi_dot
+        a1 = self._alpha1
+        a2 = self._alpha2
+        a3 = self._alpha3
+        s_sl, w_xd = self._surface(st.xi, xi_dot)
+        sp = sig_vec(s_sl, p.p2)
+        tdot_nu = es.theta_dot_nu(st)
         br = [tdot_nu[i] + a1[i] * xi_dot[i] + a2[i] * w_xd[i] + a3[i] * sp[i]
               for i in range(6)]
-        # ω̂̇* = −Θ̂⁻¹ bracket, by blocks: Θ_r x = b_r; Θ y = b_d − Θ′ x
-        acc_w = _solve3(th_r, (br[0], br[1], br[2]))
-        tx = _mv(thd, acc_w[0], acc_w[1], acc_w[2])
-        acc_v = _solve3(th, (br[3] - tx[0], br[4] - tx[1], br[5] - tx[2]))
-        acc_w = (-acc_w[0], -acc_w[1], -acc_w[2])
-        acc_v = (-acc_v[0], -acc_v[1], -acc_v[2])
-        # drift (eq. 8 + gravity; drift_wrench): M̂ [ω̂_e × ω̂_d' − ω̂̇_d'] − ω̂ × M̂ ω̂ + m ĝ
-        m = p.mass_kg
-        jm = self._inertia_f
-        fa = _cross(nu_w, wd)
-        fb = _cross(nu_w, vd)
-        fc = _cross(nu_v, wd)
-        feed_w: Vec = (fa[0] - dwd[0], fa[1] - dwd[1], fa[2] - dwd[2])
-        feed_v: Vec = (fb[0] + fc[0] - dvd[0], fb[1] + fc[1] - dvd[1], fb[2] + fc[2] - dvd[2])
-        h_b = _mv(jm, om_b[0], om_b[1], om_b[2])
-        g_w = _cross(om_b, (m * vel_b[0], m * vel_b[1], m * vel_b[2]))
-        g_v1 = _cross(om_b, h_b)
-        g_v2 = _cross(vel_b, (m * vel_b[0], m * vel_b[1], m * vel_b[2]))
-        j_feed = _mv(jm, feed_w[0], feed_w[1], feed_w[2])
-        j_acc = _mv(jm, acc_w[0], acc_w[1], acc_w[2])
-        g_b = _mv(c_bn, grav[0], grav[1], grav[2])
-        tk = [math.tanh(x / p.switching_width) for x in s_sl]
-        kp = self._k_pos_f
-        ka = self._k_att_f
-        force = [m * acc_v[i] - (m * feed_v[i] - g_w[i] + m * g_b[i]) - kp[i] * tk[3 + i]
-                 for i in range(3)]
-        torque = [j_acc[i] - (j_feed[i] - (g_v1[i] + g_v2[i])) - ka[i] * tk[i]
-                  for i in range(3)]
-        fo = _clip(force[0], force[1], force[2], p.max_force_N)
-        to = _clip(torque[0], torque[1], torque[2], p.max_torque_Nm)
-        return np.array((fo[0], fo[1], fo[2], to[0], to[1], to[2]))
-
-    def wrench_B_reference(
-        self,
-        t_ns: int,
-        q_BN: np.ndarray,
-        omega_BN_B: np.ndarray,
-        r_N_m: np.ndarray,
-        v_N_m_s: np.ndarray,
-        q_RN: np.ndarray,
-        omega_RN_B: np.ndarray,
-        r_ref_N_m: np.ndarray,
-        v_ref_N_m_s: np.ndarray,
-    ) -> np.ndarray:
-        """:meth:`wrench_B` composed from this module's array functions, term by term as the
-        paper writes it (the reference the float form is tested against)."""
-        p = self._params
-        motion = relative_motion(
-            q_BN,
-            omega_BN_B,
-            r_N_m,
-            v_N_m_s,
-            q_RN,
-            omega_RN_B,
-            r_ref_N_m,
-            v_ref_N_m_s,
-            p.mean_motion_rad_s,
-            p.mu_m3_s2,
-        )
-        xi, theta, theta_dot = attitude_state(motion, p.anti_unwinding, p.anti_unwinding_mu)
-        nu = motion.twist_e
-        xi_dot = theta @ nu
-        s_a, w_xi_dot = auxiliary_surface(xi, xi_dot, self._alpha1, self._alpha2, p.p1, self._delta)
-        s = xi_dot + self._alpha1 * xi + self._alpha2 * s_a
-        bracket = (
-            theta_dot @ nu
-            + self._alpha1 * xi_dot
-            + self._alpha2 * w_xi_dot
-            + self._alpha3 * sig(s, p.p2)
-        )
-        accel = -np.linalg.solve(theta, bracket)
-        wrench = (
-            apply_mass(p.mass_kg, self._inertia, accel)
-            - drift_wrench(motion, p.mass_kg, self._inertia)
-            - robust_wrench(self._k_att, self._k_pos, s, p.switching_width)
-        )
-        return np.concatenate(
-            (clip_norm(wrench[:3], p.max_force_N), clip_norm(wrench[3:], p.max_torque_Nm))
-        )
+        acc_w, acc_v = es.acceleration(st, br)
+        return es.wrench(st, p.mass_kg, self._inertia_f, acc_w, acc_v, s_sl, self._k_att,
+                         self._k_pos, p.switching_width, p.max_force_N, p.max_torque_Nm)

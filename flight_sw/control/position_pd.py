@@ -34,42 +34,16 @@ baseline decouples translation from attitude.
 from __future__ import annotations
 
 import math
-import numbers
-from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.control.base import error_limit
 from flight_sw.quaternion import to_dcm
 
 N_AXES = 3
 _SOURCE = "PositionPdParams"
-
-
-def _is_real(value: object) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def _three_nonnegative(key: str, value: object) -> tuple[float, float, float]:
-    expected = "3 finite numbers >= 0"
-    if not isinstance(value, Iterable):
-        raise ConfigError(_SOURCE, key, value, expected)
-    out = []
-    for v in value:
-        if not (_is_real(v) and math.isfinite(float(v)) and float(v) >= 0.0):
-            raise ConfigError(_SOURCE, key, value, expected)
-        out.append(float(v))
-    if len(out) != N_AXES:
-        raise ConfigError(_SOURCE, key, value, expected)
-    return out[0], out[1], out[2]
-
-
-def _positive_or_inf(key: str, value: object) -> float:
-    if not (_is_real(value) and float(value) > 0.0):  # type: ignore[arg-type]
-        raise ConfigError(_SOURCE, key, value, "a number > 0 (inf: no limit)")
-    return float(value)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -89,12 +63,12 @@ class PositionPdParams:
     max_speed_m_s: float = math.inf
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "kp_N_m", _three_nonnegative("kp_N_m", self.kp_N_m))
-        object.__setattr__(self, "kd_N_s_m", _three_nonnegative("kd_N_s_m", self.kd_N_s_m))
-        object.__setattr__(self, "max_force_N", _positive_or_inf("max_force_N", self.max_force_N))
-        object.__setattr__(
-            self, "max_speed_m_s", _positive_or_inf("max_speed_m_s", self.max_speed_m_s)
-        )
+        s = _SOURCE
+        object.__setattr__(self, "kp_N_m", check.triple(s, "kp_N_m", self.kp_N_m, 0.0))
+        object.__setattr__(self, "kd_N_s_m", check.triple(s, "kd_N_s_m", self.kd_N_s_m, 0.0))
+        object.__setattr__(self, "max_force_N", check.limit(s, "max_force_N", self.max_force_N))
+        max_speed = check.limit(s, "max_speed_m_s", self.max_speed_m_s, unit="m/s")
+        object.__setattr__(self, "max_speed_m_s", max_speed)
 
     @classmethod
     def from_bandwidth(
@@ -106,14 +80,10 @@ class PositionPdParams:
         max_speed_m_s: float = math.inf,
     ) -> PositionPdParams:
         """Gains giving each axis ω_n and ζ: ``K_p = m ω_n²``, ``K_d = 2 ζ ω_n m``."""
-        if not (_is_real(mass_kg) and math.isfinite(mass_kg) and mass_kg > 0.0):
-            raise ConfigError(_SOURCE, "mass_kg", mass_kg, "a finite number > 0")
-        wn = natural_frequency_rad_s
-        if not (_is_real(wn) and math.isfinite(wn) and wn > 0.0):
-            raise ConfigError(_SOURCE, "natural_frequency_rad_s", wn, "a finite number > 0")
-        zeta = damping_ratio
-        if not (_is_real(zeta) and math.isfinite(zeta) and zeta >= 0.0):
-            raise ConfigError(_SOURCE, "damping_ratio", zeta, "a finite number >= 0")
+        s = _SOURCE
+        mass_kg = check.positive(s, "mass_kg", mass_kg, unit="kg")
+        wn = check.positive(s, "natural_frequency_rad_s", natural_frequency_rad_s)
+        zeta = check.non_negative(s, "damping_ratio", damping_ratio)
         kp = mass_kg * wn * wn
         kd = 2.0 * zeta * wn * mass_kg
         return cls((kp, kp, kp), (kd, kd, kd), max_force_N, max_speed_m_s)

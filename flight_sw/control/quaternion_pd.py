@@ -39,13 +39,12 @@ textbook form here.
 from __future__ import annotations
 
 import math
-import numbers
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.control.base import error_limit
 from flight_sw.quaternion import error_quaternion
 
@@ -56,30 +55,6 @@ KP_PER_HALF_ANGLE = 2.0
 KD_FACTOR = 2.0
 
 _SOURCE = "QuaternionPdParams"
-
-
-def _is_real(value: object) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def _three_reals(
-    key: str, value: object, minimum: float, strict: bool
-) -> tuple[float, float, float]:
-    bound = f"> {minimum}" if strict else f">= {minimum}"
-    expected = f"3 finite numbers {bound}"
-    if not isinstance(value, Iterable):
-        raise ConfigError(_SOURCE, key, value, expected)
-    values: list[float] = []
-    for v in value:
-        if not _is_real(v):
-            raise ConfigError(_SOURCE, key, value, expected)
-        x = float(v)
-        if not (math.isfinite(x) and (x > minimum if strict else x >= minimum)):
-            raise ConfigError(_SOURCE, key, value, expected)
-        values.append(x)
-    if len(values) != N_AXES:
-        raise ConfigError(_SOURCE, key, value, expected)
-    return values[0], values[1], values[2]
 
 
 @dataclass(frozen=True)
@@ -96,11 +71,10 @@ class QuaternionPdParams:
     max_rate_rad_s: float = math.inf
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "kp_Nm", _three_reals("kp_Nm", self.kp_Nm, 0.0, False))
-        object.__setattr__(self, "kd_Nms", _three_reals("kd_Nms", self.kd_Nms, 0.0, False))
-        w = self.max_rate_rad_s
-        if not (isinstance(w, numbers.Real) and not isinstance(w, bool) and w > 0.0):
-            raise ConfigError(_SOURCE, "max_rate_rad_s", w, "a number > 0 (inf: no limit)")
+        s = _SOURCE
+        object.__setattr__(self, "kp_Nm", check.triple(s, "kp_Nm", self.kp_Nm, 0.0))
+        object.__setattr__(self, "kd_Nms", check.triple(s, "kd_Nms", self.kd_Nms, 0.0))
+        check.limit(s, "max_rate_rad_s", self.max_rate_rad_s, unit="rad/s")
 
     @classmethod
     def from_bandwidth(
@@ -114,14 +88,10 @@ class QuaternionPdParams:
 
         ``K_p,i = 2 J_i ω_n²``, ``K_d,i = 2 ζ ω_n J_i`` (see the module docstring).
         """
-        inertia = _three_reals("inertia_diag_kgm2", inertia_diag_kgm2, 0.0, True)
-        wn = natural_frequency_rad_s
-        if not (_is_real(wn) and math.isfinite(wn) and wn > 0.0):
-            raise ConfigError(_SOURCE, "natural_frequency_rad_s", wn, "a finite number > 0")
-        zeta = damping_ratio
-        if not (_is_real(zeta) and math.isfinite(zeta) and zeta >= 0.0):
-            raise ConfigError(_SOURCE, "damping_ratio", zeta, "a finite number >= 0")
-        jx, jy, jz = inertia
+        s = _SOURCE
+        jx, jy, jz = check.triple(s, "inertia_diag_kgm2", inertia_diag_kgm2, 0.0, lo_open=True)
+        wn = check.positive(s, "natural_frequency_rad_s", natural_frequency_rad_s)
+        zeta = check.non_negative(s, "damping_ratio", damping_ratio)
         wn_sq = wn * wn
         kp = (
             KP_PER_HALF_ANGLE * jx * wn_sq,

@@ -27,26 +27,17 @@ constant disturbances); PID form and conditional integration / clamping anti-win
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.control.quaternion_pd import QuaternionPd, QuaternionPdParams
 from flight_sw.quaternion import error_quaternion, rotation_angle_rad
 
 NS_PER_S = 1_000_000_000
 MAX_STEP_S = 1.0  # a longer gap between calls (a restart, a stall) integrates nothing
 _SOURCE = "QuaternionPidParams"
-
-
-def _positive(key: str, value: object, allow_inf: bool = False) -> float:
-    x = float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else -1.0
-    if not x > 0.0 or (not allow_inf and not math.isfinite(x)):
-        expected = "a number > 0 (inf: none)" if allow_inf else "a finite number > 0"
-        raise ConfigError(_SOURCE, key, value, expected)
-    return x
 
 
 @dataclass(frozen=True)
@@ -66,11 +57,11 @@ class QuaternionPidParams:
     max_integral_torque_Nm: float
 
     def __post_init__(self) -> None:
-        if not isinstance(self.pd, QuaternionPdParams):
-            raise ConfigError(_SOURCE, "pd", self.pd, "QuaternionPdParams")
-        _positive("integral_time_s", self.integral_time_s)
-        _positive("integral_band_rad", self.integral_band_rad)
-        _positive("max_integral_torque_Nm", self.max_integral_torque_Nm, allow_inf=True)
+        s = _SOURCE
+        check.instance(s, "pd", self.pd, QuaternionPdParams)
+        check.positive(s, "integral_time_s", self.integral_time_s, unit="s")
+        check.positive(s, "integral_band_rad", self.integral_band_rad, unit="rad")
+        check.limit(s, "max_integral_torque_Nm", self.max_integral_torque_Nm, unit="N m")
 
 
 class QuaternionPid:

@@ -17,7 +17,10 @@ Singularity guard: ``|ξ_i|`` is floored at ``XI_FLOOR`` in the negative power, 
 output stays finite (large) where the paper's TSM law is undefined.
 
 Inputs/outputs, frames, orbit terms, dual-slot convention, output limits, anti-unwinding
-option: as :mod:`flight_sw.control.nftsm_dq` (``PoseController``, ``InertiaAware``).
+option: as :mod:`flight_sw.control.nftsm_dq` (``PoseController``, ``InertiaAware``); the
+error state, kinematics, drift and wrench assembly are
+:mod:`flight_sw.control.dq_error_state`'s, on floats (the tests hold the law to the
+paper's terms composed as arrays, ``tests/flight_sw/control/dq_reference.py``).
 
 Source: seed 000, eq. (12), Section V (α = 0.67, b̂ = 0.05 + ϵ 0.1, with the NFTSM reaching
 gains α̂3, K̂, p2 and the nominal model, as the paper's reference [15] is not given);
@@ -32,23 +35,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
-from flight_sw.control.nftsm_dq import (
+from flight_sw import validation as check
+from flight_sw import vec3
+from flight_sw.control import dq_error_state as es
+from flight_sw.control.dq_error_state import MU_EARTH_M3_S2
+from flight_sw.control.nftsm_dq import sig_vec
+from flight_sw.control.nftsm_dq_params import (
     DEFAULT_ANTI_UNWINDING_MU,
     DEFAULT_SWITCHING_WIDTH,
-    MU_EARTH_M3_S2,
     N_AXES,
-    apply_mass,
-    attitude_state,
-    clip_norm,
-    drift_wrench,
-    real_in,
-    relative_motion,
-    robust_wrench,
-    sig,
-    three_positive,
     validate_inertia,
-    validate_limit,
     validate_orbit,
 )
 
@@ -87,7 +83,7 @@ class TsmDqParams:
 
     def __post_init__(self) -> None:
         s = _SOURCE
-        real_in(s, "mass_kg", self.mass_kg, 0.0, math.inf, "a finite number > 0")
+        check.positive(s, "mass_kg", self.mass_kg, unit="kg")
         for key in (
             "inertia_B_kgm2",
             "b_att",
@@ -97,16 +93,16 @@ class TsmDqParams:
             "k_att_Nm",
             "k_pos_N",
         ):
-            object.__setattr__(self, key, three_positive(s, key, getattr(self, key)))
-        real_in(s, "alpha", self.alpha, 0.5, 1.0, "a number in (0.5, 1)")
-        real_in(s, "p2", self.p2, 0.0, 1.0, "a number in (0, 1)")
+            object.__setattr__(self, key, check.triple(s, key, getattr(self, key), 0.0,
+                                                        lo_open=True))
+        check.number(s, "alpha", self.alpha, 0.5, 1.0, lo_open=True, hi_open=True)
+        check.number(s, "p2", self.p2, 0.0, 1.0, lo_open=True, hi_open=True)
         for key in ("switching_width", "anti_unwinding_mu"):
-            real_in(s, key, getattr(self, key), 0.0, math.inf, "a finite number > 0")
+            check.positive(s, key, getattr(self, key))
         validate_orbit(s, self.mean_motion_rad_s, self.mu_m3_s2)
-        if not isinstance(self.anti_unwinding, bool):
-            raise ConfigError(s, "anti_unwinding", self.anti_unwinding, "true or false")
-        validate_limit(s, "max_force_N", self.max_force_N)
-        validate_limit(s, "max_torque_Nm", self.max_torque_Nm)
+        check.flag(s, "anti_unwinding", self.anti_unwinding)
+        check.limit(s, "max_force_N", self.max_force_N, unit="N")
+        check.limit(s, "max_torque_Nm", self.max_torque_Nm, unit="N m")
 
 
 class TsmDq:
@@ -116,10 +112,11 @@ class TsmDq:
         self._params = params
         self._inertia = validate_inertia(params.inertia_B_kgm2)
         p = params
-        self._b = np.array(p.b_att + p.b_pos, dtype=float)
-        self._alpha3 = np.array(p.alpha3_att + p.alpha3_pos, dtype=float)
-        self._k_att = np.array(p.k_att_Nm, dtype=float)
-        self._k_pos = np.array(p.k_pos_N, dtype=float)
+        self._b = [float(x) for x in p.b_att + p.b_pos]
+        self._alpha3 = [float(x) for x in p.alpha3_att + p.alpha3_pos]
+        self._k_att = [float(x) for x in p.k_att_Nm]
+        self._k_pos = [float(x) for x in p.k_pos_N]
+        self._inertia_f = vec3.mat3(self._inertia)
 
     @property
     def params(self) -> TsmDqParams:
@@ -134,10 +131,17 @@ class TsmDq:
     def set_inertia_B_kgm2(self, inertia_B_kgm2: np.ndarray) -> None:
         """Use ``inertia_B_kgm2`` (3×3 SPD, or 3 principal moments) [kg m²] from now on."""
         self._inertia = validate_inertia(inertia_B_kgm2)
+        self._inertia_f = vec3.mat3(self._inertia)
+
+    def _surface(self, xi: list[float], xi_dot: list[float]) -> list[float]:
+        """``Ŝ = ξ̂̇ + b̂ ⊙ sig(ξ̂)^α`` (eq. 12)."""
+        sa = sig_vec(xi, self._params.alpha)
+        return [xi_dot[i] + self._b[i] * sa[i] for i in range(6)]
 
     def surface(self, xi: np.ndarray, xi_dot: np.ndarray) -> np.ndarray:
         """``Ŝ = ξ̂̇ + b̂ ⊙ sig(ξ̂)^α`` (eq. 12), (6,)."""
-        return np.asarray(xi_dot + self._b * sig(xi, self._params.alpha))
+        return np.array(self._surface(np.asarray(xi, dtype=float).tolist(),
+                                      np.asarray(xi_dot, dtype=float).tolist()))
 
     def wrench_B(
         self,
@@ -151,39 +155,26 @@ class TsmDq:
         r_ref_N_m: np.ndarray,
         v_ref_N_m_s: np.ndarray,
     ) -> np.ndarray:
-        """The TSM law: the demanded wrench [force_B_N; torque_B_Nm], shape (6,)."""
+        """The TSM law: the demanded wrench [force_B_N; torque_B_Nm], shape (6,).
+
+        ``ω̂̇* = −Θ̂⁻¹ [Θ̂̇ ω̂_e + α b̂ ⊙ |ξ̂|^(α−1) ⊙ ξ̂̇ + α̂3 ⊙ sig(Ŝ)^p2]`` (|ξ̂| floored at
+        :data:`XI_FLOOR`), then law (17)'s wrench
+        (:func:`flight_sw.control.dq_error_state.wrench`).
+        """
         p = self._params
-        motion = relative_motion(
-            q_BN,
-            omega_BN_B,
-            r_N_m,
-            v_N_m_s,
-            q_RN,
-            omega_RN_B,
-            r_ref_N_m,
-            v_ref_N_m_s,
-            p.mean_motion_rad_s,
-            p.mu_m3_s2,
-        )
-        xi, theta, theta_dot = attitude_state(motion, p.anti_unwinding, p.anti_unwinding_mu)
-        nu = motion.twist_e
-        xi_dot = theta @ nu
-        s = self.surface(xi, xi_dot)
-        abs_xi = np.maximum(np.abs(xi), XI_FLOOR)
-        bracket = (
-            theta_dot @ nu
-            + p.alpha * self._b * abs_xi ** (p.alpha - 1.0) * xi_dot
-            + self._alpha3 * sig(s, p.p2)
-        )
-        accel = -np.linalg.solve(theta, bracket)
-        wrench = (
-            apply_mass(p.mass_kg, self._inertia, accel)
-            - drift_wrench(motion, p.mass_kg, self._inertia)
-            - robust_wrench(self._k_att, self._k_pos, s, p.switching_width)
-        )
-        return np.concatenate(
-            (clip_norm(wrench[:3], p.max_force_N), clip_norm(wrench[3:], p.max_torque_Nm))
-        )
+        st = es.error_state(q_BN, omega_BN_B, r_N_m, v_N_m_s, q_RN, omega_RN_B, r_ref_N_m,
+                            v_ref_N_m_s, p.mean_motion_rad_s, p.mu_m3_s2, p.anti_unwinding,
+                            p.anti_unwinding_mu)
+        xi, xi_dot = st.xi, st.xi_dot
+        s = self._surface(xi, xi_dot)
+        sp = sig_vec(s, p.p2)
+        tdot_nu = es.theta_dot_nu(st)
+        b, a3, alpha = self._b, self._alpha3, p.alpha
+        br = [tdot_nu[i] + alpha * b[i] * max(abs(xi[i]), XI_FLOOR) ** (alpha - 1.0) * xi_dot[i]
+              + a3[i] * sp[i] for i in range(6)]
+        acc_w, acc_v = es.acceleration(st, br)
+        return es.wrench(st, p.mass_kg, self._inertia_f, acc_w, acc_v, s, self._k_att,
+                         self._k_pos, p.switching_width, p.max_force_N, p.max_torque_Nm)
 
 
 __all__ = ["N_AXES", "XI_FLOOR", "TsmDq", "TsmDqParams"]

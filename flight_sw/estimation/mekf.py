@@ -58,12 +58,11 @@ Shuster product, which is our Hamilton ``q̂ ⊗ δq``: Φ, Q, H are therefore u
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.estimation.base import AttitudeEstimate
 from flight_sw.quaternion import (
     error_quaternion,
@@ -83,20 +82,6 @@ N_AXES = 3
 SERIES_ANGLE_RAD = 1e-3
 
 _SOURCE = "MekfParams"
-
-
-def _is_real(value: object) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def _check_finite_nonnegative(key: str, value: float) -> None:
-    if not (_is_real(value) and math.isfinite(value) and value >= 0.0):
-        raise ConfigError(_SOURCE, key, value, "a finite number >= 0")
-
-
-def _check_finite_positive(key: str, value: float) -> None:
-    if not (_is_real(value) and math.isfinite(value) and value > 0.0):
-        raise ConfigError(_SOURCE, key, value, "a finite number > 0")
 
 
 @dataclass(frozen=True)
@@ -120,19 +105,16 @@ class MekfParams:
     initial_bias_B_rad_s: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        _check_finite_nonnegative("gyro_arw_rad_sqrt_s", self.gyro_arw_rad_sqrt_s)
-        _check_finite_nonnegative("gyro_bias_rw_rad_s_sqrt_s", self.gyro_bias_rw_rad_s_sqrt_s)
-        _check_finite_positive("star_tracker_sigma_rad", self.star_tracker_sigma_rad)
-        _check_finite_positive("initial_attitude_sigma_rad", self.initial_attitude_sigma_rad)
-        _check_finite_positive("initial_bias_sigma_rad_s", self.initial_bias_sigma_rad_s)
-        bias = self.initial_bias_B_rad_s
-        try:
-            items = tuple(bias)
-        except TypeError:
-            items = ()
-        if len(items) != N_AXES or not all(_is_real(v) and math.isfinite(v) for v in items):
-            raise ConfigError(_SOURCE, "initial_bias_B_rad_s", bias, "3 finite numbers [rad/s]")
-        object.__setattr__(self, "initial_bias_B_rad_s", tuple(float(v) for v in items))
+        s = _SOURCE
+        check.non_negative(s, "gyro_arw_rad_sqrt_s", self.gyro_arw_rad_sqrt_s)
+        check.non_negative(s, "gyro_bias_rw_rad_s_sqrt_s", self.gyro_bias_rw_rad_s_sqrt_s)
+        check.positive(s, "star_tracker_sigma_rad", self.star_tracker_sigma_rad, unit="rad")
+        check.positive(s, "initial_attitude_sigma_rad", self.initial_attitude_sigma_rad,
+                       unit="rad")
+        check.positive(s, "initial_bias_sigma_rad_s", self.initial_bias_sigma_rad_s,
+                       unit="rad/s")
+        bias = check.triple(s, "initial_bias_B_rad_s", self.initial_bias_B_rad_s, unit="rad/s")
+        object.__setattr__(self, "initial_bias_B_rad_s", bias)
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:

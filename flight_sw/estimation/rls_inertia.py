@@ -61,32 +61,29 @@ equation (2), the RLS equations with forgetting factor and Remark 1; the regress
 parametrisation of the momentum-based identification the seed cites as [7].
 
 Computation: the per-cycle arithmetic (regressor, window sums, RLS step, gates) runs on
-floats in :mod:`flight_sw.estimation.rls_kernel` (compiled); the numpy forms here
-(:func:`window_equation_reference`, :func:`rls_step_reference`) are its reference, tested
-equal to round-off.
+floats in :mod:`flight_sw.estimation.rls_kernel` (compiled), its one implementation; the
+tests hold it to a numpy form of the same equations (``tests/flight_sw/estimation/
+rls_reference.py``). An innovation matrix ``S`` too ill-conditioned for Cholesky is
+solved by the kernel's SVD path (:attr:`RlsInertiaIdentifier.n_svd_steps` counts them); a
+step whose result is not finite is skipped (:attr:`RlsInertiaIdentifier.n_refused_steps`).
 """
 
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.estimation import rls_kernel as kernel
-from flight_sw.quaternion import skew
 
 N_PARAMS = 6  # unique entries of a symmetric 3×3 tensor
 N_AXES = 3
 NS_PER_S = 1_000_000_000
 # (row, column) of each entry of θ = (J11, J12, J13, J22, J23, J33)
 THETA_INDEX = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
-# Relative asymmetry tolerated in a configured inertia guess.
-SYMMETRY_RTOL = 1e-9
-TRAPEZOID_WEIGHT = 0.5
 
 DEFAULT_FORGETTING_FACTOR = 0.999  # memory ≈ 1/(1 − λ) = 1000 cycles (20 s at 50 Hz)
 DEFAULT_INITIAL_COVARIANCE = 1.0e6  # α [(kg m²)²]: a weak prior (seed 001 Remark 1: α > 1)
@@ -95,15 +92,6 @@ DEFAULT_MIN_REGRESSOR_NORM = 0.0  # [rad/s²]: 0 = every step is used
 DEFAULT_MAX_GAP_S = 1.0  # a longer gap between samples restarts the differencing
 
 _SOURCE = "RlsInertiaParams"
-
-
-def _real(key: str, value: object, expected: str) -> float:
-    if not (isinstance(value, numbers.Real) and not isinstance(value, bool)):
-        raise ConfigError(_SOURCE, key, value, expected)
-    x = float(value)
-    if not math.isfinite(x):
-        raise ConfigError(_SOURCE, key, value, expected)
-    return x
 
 
 def inertia_matrix(theta: np.ndarray) -> np.ndarray:
@@ -116,64 +104,6 @@ def inertia_params(inertia_kgm2: np.ndarray) -> np.ndarray:
     """``θ = (J11, J12, J13, J22, J23, J33)`` of a 3×3 tensor (upper triangle, row order)."""
     j = np.asarray(inertia_kgm2, dtype=float)
     return np.array([j[r, c] for r, c in THETA_INDEX])
-
-
-def momentum_regressor(omega_B: np.ndarray) -> np.ndarray:
-    """``Ω(ω)`` (3×6) with ``J ω = Ω(ω) θ``."""
-    w1, w2, w3 = np.asarray(omega_B, dtype=float).tolist()
-    return np.array(
-        [
-            [w1, w2, w3, 0.0, 0.0, 0.0],
-            [0.0, w1, 0.0, w2, w3, 0.0],
-            [0.0, 0.0, w1, 0.0, w2, w3],
-        ]
-    )
-
-
-def euler_regressor(omega_prev_B: np.ndarray, omega_B: np.ndarray, dt_s: float) -> np.ndarray:
-    """``Φ`` (3×6) of the period-integrated Euler equation, ``Φ θ ≈ mean torque`` [N m].
-
-    ``Φ = Ω((ω − ω_prev)/dt) + ½([ω_prev×] Ω(ω_prev) + [ω×] Ω(ω))`` (module docstring).
-    """
-    w0 = np.asarray(omega_prev_B, dtype=float)
-    w1 = np.asarray(omega_B, dtype=float)
-    gyro = skew(w0) @ momentum_regressor(w0) + skew(w1) @ momentum_regressor(w1)
-    return momentum_regressor((w1 - w0) / dt_s) + TRAPEZOID_WEIGHT * gyro
-
-
-def window_equation_reference(
-    t_ns: Sequence[int], omega_B: Sequence[np.ndarray], torque_B_Nm: Sequence[np.ndarray]
-) -> tuple[np.ndarray, np.ndarray]:
-    """``(Φ, y)`` over the samples given, in numpy (the reference form of the kernel's
-    :func:`~flight_sw.estimation.rls_kernel.window_equation`); ``torque_B_Nm[0]`` unused."""
-    if len(t_ns) == 2:  # one period: the single-step form
-        return euler_regressor(omega_B[0], omega_B[1], (t_ns[1] - t_ns[0]) / NS_PER_S), \
-            np.asarray(torque_B_Nm[1], dtype=float)
-    h = np.diff(np.asarray(t_ns, dtype=float)) / NS_PER_S  # period lengths [s]
-    g = np.stack([skew(w) @ momentum_regressor(w) for w in omega_B])  # (N+1)×3×6
-    tau = np.stack([np.asarray(x, dtype=float) for x in torque_B_Nm[1:]])
-    total_s = float(h.sum())
-    gyro = TRAPEZOID_WEIGHT * np.einsum("k,kij->ij", h, g[:-1] + g[1:])
-    dw = (np.asarray(omega_B[-1], dtype=float) - np.asarray(omega_B[0], dtype=float)) / total_s
-    return momentum_regressor(dw) + gyro / total_s, h @ tau / total_s
-
-
-def rls_step_reference(
-    p: np.ndarray, theta: np.ndarray, info: np.ndarray, phi: np.ndarray, y: np.ndarray,
-    lam: float, trace_cap: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One RLS step in numpy (seed 001 §2), the reference form of the kernel's
-    :func:`~flight_sw.estimation.rls_kernel.rls_step`: ``(P_k, θ_k, R_k)``."""
-    p_phi_t = p @ phi.T
-    s = lam * np.eye(N_AXES) + phi @ p_phi_t
-    gain = np.linalg.solve(s, p_phi_t.T).T  # P Φᵀ S⁻¹ (S symmetric)
-    theta_new = theta + gain @ (y - phi @ theta)
-    p_new = (p - gain @ phi @ p) / lam
-    p_new = 0.5 * (p_new + p_new.T)
-    trace = float(np.trace(p_new))
-    if trace > trace_cap:
-        p_new *= trace_cap / trace
-    return p_new, theta_new, lam * info + phi.T @ phi
 
 
 class _Window:
@@ -212,19 +142,7 @@ class _Window:
 
 
 def _inertia_tuple(value: object) -> tuple[tuple[float, float, float], ...]:
-    expected = "a symmetric positive-definite 3×3 matrix of finite numbers [kg m²]"
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected) from None
-    if arr.shape != (N_AXES, N_AXES) or not np.all(np.isfinite(arr)):
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
-    scale = float(np.max(np.abs(arr)))
-    if not np.allclose(arr, arr.T, rtol=0.0, atol=SYMMETRY_RTOL * scale):
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
-    sym = 0.5 * (arr + arr.T)
-    if not float(np.linalg.eigvalsh(sym)[0]) > 0.0:
-        raise ConfigError(_SOURCE, "inertia_guess_B_kgm2", value, expected)
+    sym = check.inertia(_SOURCE, "inertia_guess_B_kgm2", value)
     return tuple((float(r[0]), float(r[1]), float(r[2])) for r in sym)
 
 
@@ -254,31 +172,20 @@ class RlsInertiaParams:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia_guess_B_kgm2", _inertia_tuple(self.inertia_guess_B_kgm2))
-        lam = _real("forgetting_factor", self.forgetting_factor, "a number in (0, 1]")
-        if not 0.0 < lam <= 1.0:
-            raise ConfigError(_SOURCE, "forgetting_factor", self.forgetting_factor, "in (0, 1]")
-        alpha = _real("initial_covariance", self.initial_covariance, "a finite number > 0")
-        if alpha <= 0.0:
-            raise ConfigError(
-                _SOURCE, "initial_covariance", self.initial_covariance, "a finite number > 0"
-            )
-        for key in ("min_information", "min_regressor_norm"):
-            value = getattr(self, key)
-            if _real(key, value, "a finite number >= 0") < 0.0:
-                raise ConfigError(_SOURCE, key, value, "a finite number >= 0")
-        if _real("max_gap_s", self.max_gap_s, "a finite number > 0 [s]") <= 0.0:
-            raise ConfigError(_SOURCE, "max_gap_s", self.max_gap_s, "a finite number > 0 [s]")
-        w = self.window_cycles
-        if isinstance(w, bool) or not isinstance(w, int) or w < 1:
-            raise ConfigError(_SOURCE, "window_cycles", w, "an integer >= 1")
+        s = _SOURCE
+        check.number(s, "forgetting_factor", self.forgetting_factor, 0.0, 1.0, lo_open=True)
+        check.positive(s, "initial_covariance", self.initial_covariance)
+        check.non_negative(s, "min_information", self.min_information)
+        check.non_negative(s, "min_regressor_norm", self.min_regressor_norm)
+        check.positive(s, "max_gap_s", self.max_gap_s, unit="s")
+        check.integer(s, "window_cycles", self.window_cycles, 1)
 
 
 class RlsInertiaIdentifier:
     """RLS identifier of the inertia tensor (implements ``InertiaIdentifier``).
 
-    The per-cycle arithmetic runs in :mod:`flight_sw.estimation.rls_kernel` on floats;
-    the numpy forms above (:func:`window_equation_reference`, :func:`rls_step_reference`)
-    define it and take the step when the kernel cannot (an ill-conditioned ``S``).
+    The per-cycle arithmetic runs in :mod:`flight_sw.estimation.rls_kernel` on floats
+    (an ill-conditioned ``S`` included: its SVD path).
     """
 
     def __init__(self, params: RlsInertiaParams) -> None:
@@ -288,6 +195,8 @@ class RlsInertiaIdentifier:
         self._info = _scaled_identity(0.0)
         self._window = _Window(params.window_cycles)
         self._n_updates = 0
+        self._n_svd_steps = 0
+        self._n_refused_steps = 0
 
     @property
     def params(self) -> RlsInertiaParams:
@@ -313,6 +222,17 @@ class RlsInertiaIdentifier:
     def n_updates(self) -> int:
         """RLS steps taken since construction or the last reset."""
         return self._n_updates
+
+    @property
+    def n_svd_steps(self) -> int:
+        """Steps whose innovation matrix ``S`` failed the Cholesky gate and was solved by
+        the kernel's SVD path (since construction; a reset keeps the count)."""
+        return self._n_svd_steps
+
+    @property
+    def n_refused_steps(self) -> int:
+        """Steps skipped because their result was not finite (since construction)."""
+        return self._n_refused_steps
 
     def reset(self, inertia_guess_B_kgm2: np.ndarray | None = None) -> None:
         """Restart after a known mass-property change (e.g. a capture).
@@ -365,13 +285,12 @@ class RlsInertiaIdentifier:
         lam = self._params.forgetting_factor
         trace_cap = N_PARAMS * self._params.initial_covariance
         out = kernel.rls_step(self._p, self._theta, self._info, phi, y, lam, trace_cap)
-        if out is None:  # S not numerically positive definite: LAPACK's LU solve
-            p, theta, info = rls_step_reference(
-                np.array(self._p), np.array(self._theta), np.array(self._info),
-                np.array(phi), np.array(y), lam, trace_cap,
-            )
-            out = (p.tolist(), theta.tolist(), info.tolist())
-        self._p, self._theta, self._info = out
+        if out is None:  # not finite (overflow): the estimate keeps its last value
+            self._n_refused_steps += 1
+            return
+        self._p, self._theta, self._info, by_svd = out
+        if by_svd:
+            self._n_svd_steps += 1
         self._n_updates += 1
 
     def _output(self) -> np.ndarray | None:

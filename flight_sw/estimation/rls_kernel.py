@@ -14,15 +14,23 @@ time and the arithmetic itself is about two thousand flops:
 - :func:`exceeds`: whether ``A − m I`` is positive definite (``λ_min(A) > m``), by
   Cholesky, for the identifier's excitation and positive-definiteness gates.
 
-Cholesky factorisations and solves are :func:`flight_sw.allocation.dense.cholesky_solve`'s
-(the allocators' kernel, compiled in the same group).
+Cholesky factorisations and solves are :func:`flight_sw.allocation.dense.cholesky_solve`'s,
+the singular-value fallback :func:`flight_sw.allocation.dense.least_norm_svd`'s (the
+allocators' kernels, compiled in the same group): the package's one dense solver.
 
 In and out: plain lists, matrices as lists of rows, float64. Rates [rad/s], torques [N m],
-times [s], ``θ`` [kg m²], ``P`` [(kg m²)²], ``R`` [(rad/s²)²]. :func:`rls_step` returns None
-when the 3×3 innovation matrix ``S = λ I + Φ P Φᵀ`` (positive definite in exact arithmetic,
-``S ≥ λ I``) has a Cholesky pivot at or below :data:`S_PIVOT_RTOL` times its diagonal entry:
-the caller then takes the step with numpy/LAPACK (its reference form, which defines the
-result in that case).
+times [s], ``θ`` [kg m²], ``P`` [(kg m²)²], ``R`` [(rad/s²)²].
+
+Ill-conditioned steps: the 3×3 innovation matrix ``S = λ I + Φ P Φᵀ`` is positive definite
+in exact arithmetic (``S ≥ λ I``), but with ``P Φᵀ`` ~1e14 × λ or more (a huge initial
+covariance, nearly dependent regressor rows) a Cholesky pivot can fall to round-off. When
+a pivot is at or below :data:`S_PIVOT_RTOL` times its diagonal entry, :func:`rls_step`
+solves ``S K_rᵀ = (P Φᵀ)_rᵀ`` by the one-sided Jacobi SVD instead (pseudo-inverse with no
+cut-off: every non-zero singular value is inverted, as an exact solve would), which stays
+accurate wherever the data determine the answer; it says so in its fourth return value,
+and the identifier counts these steps. Only a non-finite result (overflow, NaN in the
+inputs) is refused: :func:`rls_step` returns None and the identifier skips the step (also
+counted).
 
 Assumptions: finite inputs, ``P`` and ``R`` symmetric, ``0 < λ ≤ 1``.
 
@@ -32,14 +40,19 @@ spacecraft"), §2: Euler equation (2) and the three RLS equations with forgettin
 
 from __future__ import annotations
 
-from flight_sw.allocation.dense import cholesky_solve
+import math
+
+from flight_sw.allocation.dense import cholesky_solve, least_norm_svd
 
 N_AXES = 3
 N_PARAMS = 6
 TRAPEZOID_WEIGHT = 0.5
 # A Cholesky pivot of S below this × its diagonal entry: S is not numerically positive
-# definite (only when P Φᵀ is ~1e16 × λ); numpy's LU solve takes over.
+# definite (only when P Φᵀ is ~1e14 × λ or more); the Jacobi SVD solves it instead.
 S_PIVOT_RTOL = 1e-14
+# Singular values of S counted as zero by the SVD solve: none but exact zeros (S is positive
+# definite in exact arithmetic; the SVD is taken for accuracy, not to regularise).
+S_SVD_RCOND = 0.0
 
 Vector = list[float]
 Matrix = list[list[float]]
@@ -114,12 +127,13 @@ def exceeds(a: Matrix, m: float) -> bool:
 def rls_step(
     p: Matrix, theta: Vector, info: Matrix, phi: Matrix, y: Vector, lam: float,
     trace_cap: float,
-) -> tuple[Matrix, Vector, Matrix] | None:
-    """One RLS step: ``(P_k, θ_k, R_k)``, or None if ``S`` is not numerically positive definite.
+) -> tuple[Matrix, Vector, Matrix, bool] | None:
+    """One RLS step: ``(P_k, θ_k, R_k, by_svd)``, or None if the result is not finite.
 
     ``K = P Φᵀ S⁻¹`` with ``S = λ I3 + Φ P Φᵀ``, ``θ_k = θ + K (y − Φ θ)``,
     ``P_k = sym((P − K Φ P)/λ)`` scaled to trace ``trace_cap`` if above it,
-    ``R_k = λ R + Φᵀ Φ``.
+    ``R_k = λ R + Φᵀ Φ``. ``by_svd``: ``S`` failed the Cholesky gate and was solved by the
+    Jacobi SVD (module docstring).
     """
     # P Φᵀ (6×3); P symmetric, so Φ P = (P Φᵀ)ᵀ
     pf = [[0.0] * N_AXES for _ in range(N_PARAMS)]
@@ -148,11 +162,15 @@ def rls_step(
     # K = P Φᵀ S⁻¹: each row k_r solves S k_rᵀ = (P Φᵀ)_rᵀ
     axes = list(range(N_AXES))
     gain: Matrix = []
+    by_svd = False
     for r in range(N_PARAMS):
         row = cholesky_solve(smat, axes, pf[r], S_PIVOT_RTOL)
         if row is None:
-            return None
+            by_svd = True
+            break
         gain.append(row)
+    if by_svd:
+        gain = [least_norm_svd(smat, pf[r], S_SVD_RCOND) for r in range(N_PARAMS)]
     innovation = [0.0] * N_AXES
     for i in range(N_AXES):
         f_i = phi[i]
@@ -203,4 +221,11 @@ def rls_step(
             for i in range(N_AXES):
                 s += phi[i][r] * phi[i][c]
             o_r[c] = s
-    return p_new, theta_new, info_new
+    for v in theta_new:
+        if not math.isfinite(v):
+            return None
+    for q_r in p_new:
+        for v in q_r:
+            if not math.isfinite(v):
+                return None
+    return p_new, theta_new, info_new, by_svd

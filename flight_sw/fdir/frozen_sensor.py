@@ -30,9 +30,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 
 _SOURCE = "FrozenSensorParams"
+# Fewer than two identical samples cannot show a frozen sensor.
+MIN_IDENTICAL_SAMPLES = 2
 
 
 @dataclass(frozen=True)
@@ -49,9 +51,7 @@ class FrozenSensorParams:
 
     def __post_init__(self) -> None:
         for key in ("imu_rate_samples", "str_quat_samples"):
-            v = getattr(self, key)
-            if isinstance(v, bool) or not isinstance(v, int) or v < 2:
-                raise ConfigError(_SOURCE, key, v, "an integer >= 2")
+            check.integer(_SOURCE, key, getattr(self, key), MIN_IDENTICAL_SAMPLES)
 
     def by_message(self) -> dict[str, int]:
         """Counts by message name."""

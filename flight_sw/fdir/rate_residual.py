@@ -4,19 +4,22 @@ What it does: over a sliding window ``[t_a, t_b]`` of length ``window_s`` (re-ev
 every control cycle) it compares
 - the observed change of body rate ``Δω_meas = ω(t_b) − ω(t_a)`` (two gyro samples; the
   gyro bias cancels) with the change predicted from the on-times the flight software
-  commanded, ``Δω_pred = J⁻¹ Σ_i (r_i × d_i) T_max τ_i − J⁻¹ (ω̄ × J ω̄)(t_b − t_a)``
-  (Euler's equation, nominal inertia J, ω̄ the mean measured rate), τ_i = ∫ F_i/T_max dt
-  over the window from the expected thrust history;
+  commanded, ``Δω_pred = J⁻¹ Σ_i (r_i × d_i) T_max,i τ_i − J⁻¹ (ω̄ × J ω̄)(t_b − t_a)``
+  (Euler's equation, nominal inertia J, ω̄ the mean measured rate, ``T_max,i`` thruster i's
+  own maximum thrust), τ_i = ∫ F_i/T_max,i dt over the window from the expected thrust
+  history;
 - the observed velocity change ``Δv_meas = Σ_s (f_s − b̂) Δt`` (the accelerometer samples
   in (t_a, t_b], b̂ the estimated accelerometer bias) with the same sum over the expected
-  thrust at each sample time, ``f_pred(t_s) = Σ_i d_i T_max F_i(t_s)/(T_max m)`` (sampled
+  thrust at each sample time, ``f_pred(t_s) = Σ_i d_i F_i(t_s)/m`` (sampled
   like the accelerometer: a short pulse between two samples is seen only through its
   rise or tail, as it really is).
 The expected thrust history ``F_i(t)`` comes from :class:`flight_sw.fdir.thrust_model.
 ThrustModel`: the commands with their transmission delay and the valves' opening and
 closing delays and first-order rise and tail (the vehicle's valve data, parameters
-``command_delay_s``, ``valve_*``). Known failures (after reconfiguration) are modelled:
-a stuck-open thruster is on all the time.
+``command_delay_s``, ``valve_*``, defaults in :mod:`flight_sw.fdir.valve_timing`). Known
+failures (after reconfiguration) are modelled: a stuck-open thruster is on all the time.
+The residual itself is :class:`flight_sw.fdir.residual_model.ResidualModel`'s; this module
+decides (detection, isolation).
 
 Detection: the residual ``r = [Δω_meas − Δω_pred ; Δv_meas − Δv_pred]`` is normalised per
 axis by its expected standard deviation σ (gyro and accelerometer noise; relative model
@@ -34,8 +37,8 @@ detector, more sensitive to a failure's own signature than the plain norm).
 Isolation (generalised likelihood ratio, one amplitude per hypothesis): each hypothesis
 "thruster i stuck closed" or "stuck open" predicts a residual signature: stuck closed
 removes a share β of the thrust the model expects from thruster i (angular window change
-``−β J⁻¹(r_i × d_i) T_max τ_i``, and at every accelerometer sample
-``−β d_i T_max F_i(t_s)/(T_max m)``); stuck open adds full thrust where none was expected
+``−β J⁻¹(r_i × d_i) T_max,i τ_i``, and at every accelerometer sample
+``−β d_i F_i(t_s)/m``); stuck open adds full thrust where none was expected
 (``+β`` times the same with ``τ_i → W − τ_i``, ``F_i → 1 − F_i``). The least-squares β,
 clipped to ``[0, 1 + ε]`` (ε the relative errors), gives each hypothesis its likelihood
 gain (the drop of the normalised squared residual, angular window plus every accelerometer
@@ -53,8 +56,9 @@ The accelerometer bias b̂ is tracked by a first-order filter (time constant
 Inputs: ``on_command``, ``on_gyro``, ``on_accel`` (see :mod:`flight_sw.fdir.base`);
 construction: the 6×n effectiveness matrix (rows force [N/N] then torque [N m/N], body
 axes, :mod:`flight_sw.allocation.effectiveness`), nominal inertia [kg m²] and mass [kg],
-T_max [N], minimum on-time [s]. Output: :class:`flight_sw.fdir.base.Verdict`; the numbers
-of the last evaluation in :attr:`RateResidualFdir.last`.
+the maximum thrust of each thruster [N] (shape (n,)), minimum on-time [s]. Output:
+:class:`flight_sw.fdir.base.Verdict`; the numbers of the last evaluation in
+:attr:`RateResidualFdir.last`.
 
 Assumptions: rigid body, IMU at the centre of mass with axes along B, no external force
 or torque beyond the thrusters that matters over a window (disturbances of the order of
@@ -72,14 +76,11 @@ equation and ``r × F``: Wie 2008, "Space Vehicle Dynamics and Control", 2nd ed.
 from __future__ import annotations
 
 import math
-import numbers
-from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
 from flight_sw.fdir.base import (
     NOTHING,
     FailureKind,
@@ -87,106 +88,13 @@ from flight_sw.fdir.base import (
     ThrusterFdirStrategy,
     Verdict,
 )
+from flight_sw.fdir.rate_residual_params import RateResidualParams
+from flight_sw.fdir.residual_model import Residual, ResidualModel
 from flight_sw.fdir.thrust_model import ThrustModel
-from flight_sw.quaternion import cross as cross3
 
-NS_PER_S = 1_000_000_000
 S_PER_NS = 1e-9
-# History kept beyond one window: commands whose pulses may still overlap it, late samples.
-HISTORY_MARGIN = 6
-# A window shorter than this fraction of ``window_s`` is not evaluated (start-up, gaps).
-MIN_WINDOW_FRACTION = 0.75
 
-_SOURCE = "RateResidualParams"
-
-
-def _positive(key: str, value: object, allow_zero: bool = False) -> None:
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
-    if not ok or value < 0.0 or (value == 0.0 and not allow_zero):  # type: ignore[operator]
-        raise ConfigError(_SOURCE, key, value, f"a finite number {'>=' if allow_zero else '>'} 0")
-
-
-def _count(key: str, value: object) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-        raise ConfigError(_SOURCE, key, value, "an integer >= 1")
-
-
-@dataclass(frozen=True)
-class RateResidualParams:
-    """Settings of the residual FDIR (see the module docstring for their roles).
-
-    Attributes:
-        window_s: residual window [s] (> 0).
-        threshold: detection threshold on ‖z‖, the normalised residual norm (> 0).
-        glr_threshold: detection threshold on the best hypothesis' likelihood gain (> 0).
-        persistence_cycles: consecutive cycles above threshold to detect (≥ 1).
-        isolation_cycles: consecutive detected cycles the same hypothesis must win (≥ 1).
-        explained_fraction: largest share of ‖z‖² the winning hypothesis may leave (0, 1].
-        isolation_margin: smallest likelihood gain of the winner over the best hypothesis
-            on another thruster (≥ 0; 2 ln of a likelihood ratio).
-        command_delay_s: control-cycle time to the command's reception by the valves [s].
-        valve_open_delay_s, valve_close_delay_s: valve transport delays [s] (≥ 0).
-        valve_rise_tau_s, valve_tail_tau_s: first-order rise and tail time constants [s].
-        edge_uncertainty_s: 1σ timing error of each modelled valve edge [s] (≥ 0).
-        gyro_noise_rad_s: 1σ noise of one gyro sample, quantisation included [rad/s] (> 0).
-        accel_noise_m_s2: 1σ noise of one accelerometer sample [m/s²] (> 0).
-        accel_bias_m_s2: 1σ uncertainty of the tracked accelerometer bias [m/s²] (≥ 0).
-        model_rel_error: relative error of the net predicted change (inertia, mass) (≥ 0).
-        thrust_rel_error: relative thrust error of each thruster (≥ 0).
-        bias_time_constant_s: time constant of the accelerometer-bias filter [s] (> 0).
-        use_accel: use the accelerometer (linear) channel.
-    """
-
-    window_s: float = 0.5
-    threshold: float = 5.0
-    glr_threshold: float = 20.0
-    persistence_cycles: int = 3
-    isolation_cycles: int = 3
-    explained_fraction: float = 0.35
-    isolation_margin: float = 6.0
-    command_delay_s: float = 0.0015
-    valve_open_delay_s: float = 0.003
-    valve_close_delay_s: float = 0.002
-    valve_rise_tau_s: float = 0.002
-    valve_tail_tau_s: float = 0.003
-    edge_uncertainty_s: float = 0.0005
-    gyro_noise_rad_s: float = 5e-5
-    accel_noise_m_s2: float = 5e-3
-    accel_bias_m_s2: float = 1e-3
-    model_rel_error: float = 0.1
-    thrust_rel_error: float = 0.05
-    bias_time_constant_s: float = 10.0
-    use_accel: bool = True
-
-    def __post_init__(self) -> None:
-        _positive("window_s", self.window_s)
-        _positive("threshold", self.threshold)
-        _positive("glr_threshold", self.glr_threshold)
-        _count("persistence_cycles", self.persistence_cycles)
-        _count("isolation_cycles", self.isolation_cycles)
-        _positive("explained_fraction", self.explained_fraction)
-        _positive("isolation_margin", self.isolation_margin, allow_zero=True)
-        if self.explained_fraction > 1.0:
-            raise ConfigError(
-                _SOURCE, "explained_fraction", self.explained_fraction, "a number in (0, 1]"
-            )
-        for key in (
-            "command_delay_s",
-            "valve_open_delay_s",
-            "valve_close_delay_s",
-            "valve_rise_tau_s",
-            "valve_tail_tau_s",
-        ):
-            _positive(key, getattr(self, key), allow_zero=True)
-        _positive("edge_uncertainty_s", self.edge_uncertainty_s, allow_zero=True)
-        _positive("gyro_noise_rad_s", self.gyro_noise_rad_s)
-        _positive("accel_noise_m_s2", self.accel_noise_m_s2)
-        _positive("accel_bias_m_s2", self.accel_bias_m_s2, allow_zero=True)
-        _positive("model_rel_error", self.model_rel_error, allow_zero=True)
-        _positive("thrust_rel_error", self.thrust_rel_error, allow_zero=True)
-        _positive("bias_time_constant_s", self.bias_time_constant_s)
-        if not isinstance(self.use_accel, bool):
-            raise ConfigError(_SOURCE, "use_accel", self.use_accel, "a bool")
+__all__ = ["RateResidualFdir", "RateResidualParams", "ResidualSample"]
 
 
 @dataclass(frozen=True)
@@ -217,43 +125,6 @@ class ResidualSample:
     unexplained: float
 
 
-@dataclass
-class _GyroSample:
-    """A gyro sample, the cumulative modelled thrust-time up to it and edges near it."""
-
-    t_ns: int
-    omega: np.ndarray
-    cum_s: np.ndarray | None = None
-    edges: np.ndarray | None = None
-
-
-@dataclass
-class _AccelSample:
-    """An accelerometer sample and the modelled thrust fraction and its rate at it."""
-
-    t_ns: int
-    f: np.ndarray
-    frac: np.ndarray | None = None
-    rate: np.ndarray | None = None
-
-
-@dataclass(frozen=True)
-class Residual:
-    """The residual of one window and what the hypothesis test needs (internal)."""
-
-    t_a_ns: int
-    t_b_ns: int
-    span_s: float
-    z: np.ndarray  # (6,) normalised window residual
-    tau_cmd_s: np.ndarray  # (n,) commanded thrust-time in the window [s]
-    h_ang: np.ndarray  # (3, n) angular change per second of full thrust, over σ
-    h_lin: np.ndarray  # (3, n) window velocity change per second of full thrust, over σ
-    u_s: np.ndarray  # (n,) sampled thrust-time [s]
-    frac: np.ndarray  # (samples, n) expected thrust fraction at the accelerometer samples
-    w_lin: np.ndarray  # (samples, 3) sample residual over its variance
-    inv_var: np.ndarray  # (samples, 3) 1/variance of each sample residual
-
-
 class RateResidualFdir(ThrusterFdirStrategy):
     """Residual-based thruster FDIR (see the module docstring)."""
 
@@ -264,56 +135,31 @@ class RateResidualFdir(ThrusterFdirStrategy):
         effectiveness: np.ndarray,
         inertia_B_kgm2: np.ndarray,
         mass_kg: float,
-        max_thrust_N: float,
+        max_thrust_N: np.ndarray,
         min_on_s: float,
         control_period_ns: int,
         imu_period_ns: int,
         params: RateResidualParams,
     ) -> None:
-        b = np.asarray(effectiveness, dtype=float)
-        if b.ndim != 2 or b.shape[0] != 6 or b.shape[1] < 1:
-            raise ConfigError(_SOURCE, "effectiveness", b.shape, "a 6×n wrench matrix")
-        j = np.asarray(inertia_B_kgm2, dtype=float)
-        if j.shape != (3, 3):
-            raise ConfigError(_SOURCE, "inertia_B_kgm2", j.shape, "a 3×3 matrix")
+        self._res = ResidualModel(effectiveness, inertia_B_kgm2, mass_kg, max_thrust_N, min_on_s,
+                                  control_period_ns, imu_period_ns, params)
         self.params = params
-        self.n = b.shape[1]
-        self._j = j
-        j_inv = np.linalg.inv(j)
-        self._j_inv = j_inv
-        # Per thruster, full thrust: angular acceleration [rad/s²] and linear [m/s²].
-        self._ang = j_inv @ b[3:6] * max_thrust_N
-        self._lin = b[0:3] * (max_thrust_N / mass_kg)
+        self.n = self._res.n
         self._period_ns = control_period_ns
-        self._imu_period_s = imu_period_ns * S_PER_NS
-        self._window_ns = round(params.window_s * NS_PER_S)
-        self._n_imu = math.ceil(self._window_ns / imu_period_ns) + HISTORY_MARGIN
-        self.model = ThrustModel(
-            self.n,
-            min_on_s,
-            params.command_delay_s,
-            params.valve_open_delay_s,
-            params.valve_close_delay_s,
-            params.valve_rise_tau_s,
-            params.valve_tail_tau_s,
-            self._window_ns + HISTORY_MARGIN * control_period_ns,
-        )
         self.last: ResidualSample | None = None
         self.reset()
+
+    @property
+    def model(self) -> ThrustModel:
+        """The expected-thrust model of the commands sent."""
+        return self._res.thrust
 
     # --- observations ---------------------------------------------------------------
 
     def reset(self) -> None:
         """Forget every observation and known failure."""
-        n = self.n
-        self.model.reset()
-        # samples with their model quantities, computed once (at the first evaluation after
-        # they arrive: by then no command can change the modelled thrust at their time)
-        self._gyro: deque[_GyroSample] = deque(maxlen=self._n_imu)
-        self._accel: deque[_AccelSample] = deque(maxlen=self._n_imu)
-        self._known = np.zeros(n, dtype=bool)
-        self._pending_bias: np.ndarray | None = None
-        self._bias = np.zeros(3)
+        self._res.reset()
+        self._known = np.zeros(self.n, dtype=bool)
         self._quiet_until_ns: int | None = None
         self._above = 0
         self._t_detect: int | None = None
@@ -323,40 +169,17 @@ class RateResidualFdir(ThrusterFdirStrategy):
 
     def on_command(self, t_ns: int, on_time_s: np.ndarray) -> None:
         """Add the commands of the period starting at ``t_ns`` to the thrust model."""
-        self.model.command(t_ns, on_time_s)
+        self._res.thrust.command(t_ns, on_time_s)
         if self._quiet_until_ns is None:  # evaluate only once a window of commands exists
-            self._quiet_until_ns = t_ns + self._window_ns
+            self._quiet_until_ns = t_ns + self._res.window_ns
 
     def on_gyro(self, t_ns: int, omega_meas_B: np.ndarray) -> None:
         """Keep the gyro sample (time order is the caller's; older samples are dropped)."""
-        if self._gyro and t_ns <= self._gyro[-1].t_ns:
-            return
-        self._gyro.append(_GyroSample(t_ns, np.array(omega_meas_B, dtype=float)))
+        self._res.add_gyro(t_ns, omega_meas_B)
 
     def on_accel(self, t_ns: int, f_meas_B: np.ndarray) -> None:
         """Keep the accelerometer sample."""
-        if self._accel and t_ns <= self._accel[-1].t_ns:
-            return
-        self._accel.append(_AccelSample(t_ns, np.array(f_meas_B, dtype=float)))
-
-    def _refresh(self) -> None:
-        """Model quantities of the samples that have none yet (each computed once)."""
-        model = self.model
-        guard = round(2.0 * self.params.edge_uncertainty_s * NS_PER_S)
-        prev: _GyroSample | None = None
-        for g in self._gyro:
-            if g.cum_s is None:
-                if prev is None or prev.cum_s is None:
-                    g.cum_s = np.zeros(self.n)
-                else:
-                    g.cum_s = prev.cum_s + model.thrust_time_s(prev.t_ns, g.t_ns)
-                g.edges = model.boundary_segments(g.t_ns, guard)
-            prev = g
-        new = [a for a in self._accel if a.frac is None]
-        if new:
-            frac, rate = model.fraction_at(np.array([a.t_ns for a in new], dtype=np.int64))
-            for i, a in enumerate(new):
-                a.frac, a.rate = frac[i], rate[i]
+        self._res.add_accel(t_ns, f_meas_B)
 
     def set_failures(self, t_ns: int, failures: Sequence[ThrusterFailure]) -> None:
         """Model the known failures from now on; restart the tests after one window."""
@@ -364,99 +187,15 @@ class RateResidualFdir(ThrusterFdirStrategy):
             if 0 <= f.thruster < self.n:
                 self._known[f.thruster] = True
                 if f.kind == FailureKind.STUCK_OPEN:
-                    self.model.stuck_open[f.thruster] = True
-        self._quiet_until_ns = t_ns + self._window_ns
+                    self._res.thrust.stuck_open[f.thruster] = True
+        self._quiet_until_ns = t_ns + self._res.window_ns
         self._above = 0
         self._t_detect = None
         self._streak_id, self._streak = -1, 0
 
-    # --- model ----------------------------------------------------------------------
-
-    def _window(self, t_ns: int) -> tuple[_GyroSample, _GyroSample] | None:
-        """The gyro samples opening and closing the window (the newest one closes it)."""
-        if len(self._gyro) < 2:
-            return None
-        b = self._gyro[-1]
-        a = self._gyro[0]
-        for g in self._gyro:
-            if g.t_ns >= b.t_ns - self._window_ns:
-                a = g
-                break
-        if b.t_ns - a.t_ns < MIN_WINDOW_FRACTION * self._window_ns:
-            return None
-        return a, b
-
     def residual(self, t_ns: int) -> Residual | None:
         """The residual of the window ending at the newest gyro sample (None: too short)."""
-        win = self._window(t_ns)
-        if win is None:
-            return None
-        self._refresh()
-        p = self.params
-        n = self.n
-        ga, gb = win
-        assert ga.cum_s is not None and gb.cum_s is not None
-        assert ga.edges is not None and gb.edges is not None
-        t_a, w_a, t_b, w_b = ga.t_ns, ga.omega, gb.t_ns, gb.omega
-        span_s = (t_b - t_a) * S_PER_NS
-        model = self.model
-        tau_s = gb.cum_s - ga.cum_s  # (n,) thrust-time in the window [s]
-        tau_cmd_s = np.where(model.stuck_open, 0.0, tau_s)
-        edges = ga.edges + gb.edges
-        # angular channel
-        w_bar = 0.5 * (w_a + w_b)
-        gyroscopic = self._j_inv @ cross3(w_bar, self._j @ w_bar) * span_s
-        dw_pred = self._ang @ tau_s - gyroscopic
-        r_ang = (w_b - w_a) - dw_pred
-        contrib_ang = self._ang * tau_s  # (3, n)
-        var_ang = (
-            2.0 * p.gyro_noise_rad_s**2
-            + (p.model_rel_error * dw_pred) ** 2
-            + (p.thrust_rel_error**2) * (contrib_ang**2).sum(axis=1)
-            + (p.edge_uncertainty_s**2) * (self._ang**2 @ edges)
-        )
-        sig_ang = np.sqrt(var_ang)
-        z = np.zeros(6)
-        z[0:3] = r_ang / sig_ang
-        h_ang = self._ang / sig_ang[:, None]
-        # linear channel (sampled like the accelerometer)
-        acc = [a for a in self._accel if t_a < a.t_ns <= t_b] if p.use_accel else []
-        self._pending_bias = None
-        s_count = len(acc) if len(acc) >= 2 else 0
-        frac = np.zeros((s_count, n))
-        w_lin = np.zeros((s_count, 3))
-        inv_var = np.zeros((s_count, 3))
-        h_lin = np.zeros((3, n))
-        u_s = np.zeros(n)
-        if s_count:
-            fs = np.array([a.f for a in acc])
-            frac = np.array([a.frac for a in acc])
-            rate = np.array([a.rate for a in acc])
-            dt = self._imu_period_s
-            f_pred = frac @ self._lin.T  # (samples, 3)
-            r_s = (fs - self._bias) - f_pred
-            var_s = (
-                p.accel_noise_m_s2**2
-                + p.accel_bias_m_s2**2
-                + (p.model_rel_error * f_pred) ** 2
-                + (p.thrust_rel_error**2) * ((frac**2) @ (self._lin.T**2))
-                + (p.edge_uncertainty_s**2) * ((rate**2) @ (self._lin.T**2))
-            )
-            inv_var = 1.0 / var_s
-            w_lin = r_s * inv_var
-            u_s = frac.sum(axis=0) * dt  # sampled thrust-time per thruster [s]
-            r_lin = r_s.sum(axis=0) * dt
-            sig_lin = np.sqrt(
-                s_count * (p.accel_noise_m_s2 * dt) ** 2
-                + (p.accel_bias_m_s2 * span_s) ** 2
-                + (p.model_rel_error * (self._lin @ u_s)) ** 2
-                + (p.thrust_rel_error**2) * ((self._lin * u_s) ** 2).sum(axis=1)
-                + (p.edge_uncertainty_s * dt) ** 2 * ((rate @ self._lin.T) ** 2).sum(axis=0)
-            )
-            z[3:6] = r_lin / sig_lin
-            h_lin = self._lin / sig_lin[:, None]
-            self._pending_bias = (fs.mean(axis=0)) - f_pred.mean(axis=0)
-        return Residual(t_a, t_b, span_s, z, tau_cmd_s, h_ang, h_lin, u_s, frac, w_lin, inv_var)
+        return self._res.residual(t_ns)
 
     # --- decision -------------------------------------------------------------------
 
@@ -471,8 +210,8 @@ class RateResidualFdir(ThrusterFdirStrategy):
         p = self.params
         n = self.n
         frac_cmd = res.frac.copy()
-        frac_cmd[:, self.model.stuck_open] = 0.0
-        lin = self._lin
+        frac_cmd[:, self._res.thrust.stuck_open] = 0.0
+        lin = self._res.lin
         wl = res.w_lin @ lin  # (samples, n): Σ_axis r/σ² · lin_i
         ivl = res.inv_var @ (lin**2)  # (samples, n): Σ_axis lin_i²/σ²
         g_ang_c = -res.h_ang * res.tau_cmd_s  # (3, n)
@@ -496,11 +235,11 @@ class RateResidualFdir(ThrusterFdirStrategy):
         gain = 2.0 * beta * hz - beta**2 * hh
         known = np.concatenate((self._known, self._known))
         gain[known] = -np.inf
-        dt = self._imu_period_s
+        dt = self._res.imu_period_s
         u_open = res.frac.shape[0] * dt - res.u_s
         sig = np.zeros((6, 2 * n))
         sig[0:3, :n], sig[0:3, n:] = g_ang_c, g_ang_o
-        sig[3:6, :n] = -res.h_lin * np.where(self.model.stuck_open, 0.0, res.u_s)
+        sig[3:6, :n] = -res.h_lin * np.where(self._res.thrust.stuck_open, 0.0, res.u_s)
         sig[3:6, n:] = res.h_lin * np.maximum(u_open, 0.0)
         return gain, beta, sig
 
@@ -510,7 +249,7 @@ class RateResidualFdir(ThrusterFdirStrategy):
         if self._quiet_until_ns is None or t_ns < self._quiet_until_ns:
             self.last = None
             return NOTHING
-        res = self.residual(t_ns)
+        res = self._res.residual(t_ns)
         if res is None:
             return NOTHING
         z = res.z
@@ -525,9 +264,7 @@ class RateResidualFdir(ThrusterFdirStrategy):
             self._above = 0
             self._t_detect = None
             self._streak_id, self._streak = -1, 0
-            if self._pending_bias is not None:
-                alpha = min(1.0, self._period_ns * S_PER_NS / p.bias_time_constant_s)
-                self._bias += alpha * (self._pending_bias - self._bias)
+            self._res.track_bias(min(1.0, self._period_ns * S_PER_NS / p.bias_time_constant_s))
         detected = self._above >= p.persistence_cycles
         failure = None
         thruster = best % n

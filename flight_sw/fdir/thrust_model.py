@@ -19,7 +19,9 @@ So the model is piecewise exponential: segments ``(start, end, F0, target, τ)``
 ``target (u2 − u1) + (F0 − target) τ (e^{−(u1 − start)/τ} − e^{−(u2 − start)/τ})``.
 A thruster declared stuck open is at full thrust all the time.
 
-Inputs: ``command(t_ns, on_time_s)`` per control cycle, in time order. Outputs: see above;
+Inputs: the valve timing (:class:`flight_sw.fdir.valve_timing.ValveTiming`: command delay
+δ, opening and closing delays, rise and tail time constants); ``command(t_ns,
+on_time_s)`` per control cycle, in time order. Outputs: see above;
 fractions are dimensionless, times integer ns in, seconds out.
 
 Assumptions: the valve parameters are the vehicle's nominal ones (a valve that differs
@@ -38,33 +40,31 @@ import math
 
 import numpy as np
 
+from flight_sw.fdir.valve_timing import ValveTiming
+
 NS_PER_S = 1_000_000_000
 S_PER_NS = 1e-9
 INF_NS = 2**62
 SEGMENT_CAPACITY = 1024  # initial rows of the finished-segment arrays (they grow if needed)
+# A rise or tail time constant below this [s] is taken as this (an instant edge: the
+# exponentials stay finite).
+MIN_TIME_CONSTANT_S = 1e-6
 
 
 class ThrustModel:
     """Piecewise-exponential expected thrust per thruster (see the module docstring)."""
 
     def __init__(
-        self,
-        n_thrusters: int,
-        min_on_s: float,
-        command_delay_s: float,
-        open_delay_s: float,
-        close_delay_s: float,
-        rise_tau_s: float,
-        tail_tau_s: float,
-        horizon_ns: int,
+        self, n_thrusters: int, min_on_s: float, timing: ValveTiming, horizon_ns: int
     ) -> None:
         self.n = n_thrusters
+        self.timing = timing
         self._min_on_ns = round(min_on_s * NS_PER_S)
-        self._delay_ns = round(command_delay_s * NS_PER_S)
-        self._od_ns = round(open_delay_s * NS_PER_S)
-        self._cd_ns = round(close_delay_s * NS_PER_S)
-        self._tau_r = max(rise_tau_s, 1e-6)
-        self._tau_t = max(tail_tau_s, 1e-6)
+        self._delay_ns = round(timing.command_delay_s * NS_PER_S)
+        self._od_ns = round(timing.open_delay_s * NS_PER_S)
+        self._cd_ns = round(timing.close_delay_s * NS_PER_S)
+        self._tau_r = max(timing.rise_tau_s, MIN_TIME_CONSTANT_S)
+        self._tau_t = max(timing.tail_tau_s, MIN_TIME_CONSTANT_S)
         self._horizon_ns = horizon_ns
         self.stuck_open = np.zeros(n_thrusters, dtype=bool)
         self.reset()

@@ -41,12 +41,13 @@ practice (ECSS-E-ST-70-11C, on-board monitoring with filters).
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.fdir.base import (
     NOTHING,
     FailureKind,
@@ -56,11 +57,20 @@ from flight_sw.fdir.base import (
 )
 
 _SOURCE = "ValveStatusParams"
+MAX_THR_STATUS = 16  # THR_STATUS carries thrusters 0..15
+STATUS_CMD = tuple(f"Cmd_T{k:02d}" for k in range(MAX_THR_STATUS))  # its signal names
+STATUS_OPEN = tuple(f"Open_T{k:02d}" for k in range(MAX_THR_STATUS))
+STATUS_CURRENT = tuple(f"Current_T{k:02d}" for k in range(MAX_THR_STATUS))
 
 
-def _int_at_least(key: str, value: object, lo: int) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < lo:
-        raise ConfigError(_SOURCE, key, value, f"an integer >= {lo}")
+def status_flags(signals: Mapping[str, Any], n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per thruster (the first ``min(n, 16)``): coil commanded, valve open, coil current, as
+    boolean arrays from a decoded THR_STATUS frame (absent signals read as 0)."""
+    k_max = min(n, MAX_THR_STATUS)
+    cmd = np.array([bool(signals.get(STATUS_CMD[k], 0)) for k in range(k_max)])
+    opened = np.array([bool(signals.get(STATUS_OPEN[k], 0)) for k in range(k_max)])
+    current = np.array([bool(signals.get(STATUS_CURRENT[k], 0)) for k in range(k_max)])
+    return cmd, opened, current
 
 
 @dataclass(frozen=True)
@@ -80,10 +90,9 @@ class ValveStatusParams:
     quiet_cycles: int = 2
 
     def __post_init__(self) -> None:
-        _int_at_least("stuck_closed_samples", self.stuck_closed_samples, 1)
-        _int_at_least("window_samples", self.window_samples, 1)
-        _int_at_least("stuck_open_samples", self.stuck_open_samples, 1)
-        _int_at_least("quiet_cycles", self.quiet_cycles, 1)
+        for key in ("stuck_closed_samples", "window_samples", "stuck_open_samples",
+                    "quiet_cycles"):
+            check.integer(_SOURCE, key, getattr(self, key), 1)
 
 
 class ValveStatusFdir(ThrusterFdirStrategy):
@@ -92,8 +101,7 @@ class ValveStatusFdir(ThrusterFdirStrategy):
     name = "valve_status"
 
     def __init__(self, n_thrusters: int, params: ValveStatusParams) -> None:
-        if n_thrusters < 1:
-            raise ConfigError(_SOURCE, "n_thrusters", n_thrusters, "an integer >= 1")
+        check.integer("ValveStatusFdir", "n_thrusters", n_thrusters, 1)
         self.params = params
         self.n = n_thrusters
         self.reset()

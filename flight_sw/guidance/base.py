@@ -24,14 +24,28 @@ from typing import Protocol
 
 import numpy as np
 
+from dbc.errors import ConfigError
+from flight_sw import validation as check
+
 QUATERNION_SIZE = 4
 VECTOR_SIZE = 3
 
+_SOURCE = "AttitudeReference"
+
 
 def _frozen(name: str, value: object, size: int) -> np.ndarray:
-    arr = np.array(value, dtype=float)
+    """``value`` as a read-only float array of ``size`` finite numbers (ConfigError else).
+
+    The array test runs first (every cycle builds a reference); the validator only words
+    the error.
+    """
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.zeros(0)
     if arr.shape != (size,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} = {value!r}: expected {size} finite numbers")
+        check.vector(_SOURCE, name, value, size)  # raises, naming the field
+        raise ConfigError(_SOURCE, name, value, f"{size} finite numbers")  # e.g. a bool
     arr.setflags(write=False)
     return arr
 

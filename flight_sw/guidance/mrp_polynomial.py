@@ -2,16 +2,14 @@
 
 What it does: ``σ_RN(τ)`` with each component a polynomial in ``τ = (t − t0)`` [s],
 converted to the reference quaternion, with the reference rate and angular acceleration
-from the MRP kinematics, all analytic:
+from the MRP kinematics, all analytic (the MRP algebra is :mod:`flight_sw.mrp`'s):
 - MRP → quaternion (``s = σᵀσ``): ``q0 = (1 − s)/(1 + s)``, ``q_vec = 2σ/(1 + s)``
   (``σ = e tan(φ/4)``, the MRP of the rotation the quaternion describes, same N → R sense,
   so ``C(σ) = C(q)`` of :mod:`flight_sw.quaternion`);
-- kinematics (seed 001 eq. (1)): ``σ̇ = F(σ) ω``, ``F(σ) = ¼ B(σ)``,
-  ``B(σ) = (1 − s) I3 + 2[σ×] + 2σσᵀ``; inverse (seed 001, after eq. (1)):
-  ``F⁻¹ = 16/(1 + s)² Fᵀ``, so ``ω_RN_R = 4/(1 + s)² Bᵀ σ̇``;
-- its derivative (product rule, ``ṡ = 2σᵀσ̇``):
-  ``ω̇ = 4/(1 + s)² (Ḃᵀ σ̇ + Bᵀ σ̈) − 2 ṡ/(1 + s) · ω``, with
-  ``Ḃᵀ = −ṡ I3 − 2[σ̇×] + 2(σσ̇ᵀ + σ̇σᵀ)``.
+- kinematics (seed 001 eq. (1)): ``σ̇ = F(σ) ω``; inverse (seed 001, after eq. (1)):
+  ``ω_RN_R = F⁻¹(σ) σ̇ = 16/(1 + s)² F(σ)ᵀ σ̇``;
+- its derivative (product rule, ``ṡ = 2σᵀσ̇``): ``ω̇ = Ġ σ̇ + G σ̈`` with ``G = F⁻¹``,
+  ``Ġ = 16/(1 + s)² Ḟᵀ − 2ṡ/(1 + s) G``.
 
 Default trajectory: seed 001 §5 (its desired MRP ``σ_d``, 100 s manoeuvre):
     ``σd1 = −1.475e−8 τ⁴ + 4.559e−6 τ³ − 5.105e−4 τ² + 0.02439 τ + 0.08381``,
@@ -31,7 +29,7 @@ caller's time base], ``duration_s`` [s].
 
 Assumptions: the MRP stays in the unit ball on the manoeuvre (true for the default:
 |σ| < 0.88), so ``q0 > 0`` and the quaternion is continuous; no switching to the shadow
-set is done. The MRP helpers live here on purpose (no dependency on a shared MRP module).
+set is done.
 
 Sources: seed 001 eq. (1) and the expression of F⁻¹ after it (MRP kinematics), §5
 (desired trajectory σ_d); Schaub & Junkins, "Analytical Mechanics of Space Systems",
@@ -40,21 +38,18 @@ MRP ↔ quaternion relations and ``ω = 4/(1 + σ²)² Bᵀ σ̇``.
 
 from __future__ import annotations
 
-import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from dbc.errors import ConfigError
+from flight_sw import mrp
+from flight_sw import validation as check
 from flight_sw.guidance.base import VECTOR_SIZE, AttitudeReference
-from flight_sw.quaternion import skew
 
 NS_PER_S = 1_000_000_000
-# Kinematics constants (ω = OMEGA_GAIN/(1 + s)² Bᵀ σ̇; B = (1 − s) I + 2[σ×] + 2σσᵀ).
-OMEGA_GAIN = 4.0
-B_CROSS = 2.0
-B_OUTER = 2.0
+_SOURCE = "MrpPolynomialGuidance"
 
 # Seed 001 §5, desired MRP σ_d (ascending powers of τ [s]); see the module docstring.
 SEED001_SIGMA_COEFFS: tuple[tuple[float, ...], ...] = (
@@ -65,71 +60,13 @@ SEED001_SIGMA_COEFFS: tuple[tuple[float, ...], ...] = (
 SEED001_DURATION_S = 100.0  # "The time of the attitude control is 100 s."
 
 
-def mrp_to_quaternion(sigma: np.ndarray) -> np.ndarray:
-    """Scalar-first quaternion of the MRP ``σ``: ``((1 − s)/(1 + s), 2σ/(1 + s))``, s = σᵀσ."""
-    sig = np.asarray(sigma, dtype=float)
-    s = float(sig @ sig)
-    return np.concatenate(([(1.0 - s) / (1.0 + s)], 2.0 * sig / (1.0 + s)))
-
-
-def quaternion_to_mrp(q: np.ndarray) -> np.ndarray:
-    """MRP ``q_vec/(1 + q0)`` of a unit quaternion, short way (q and −q give the same σ)."""
-    qa = np.asarray(q, dtype=float)
-    if qa[0] < 0.0:
-        qa = -qa
-    return qa[1:] / (1.0 + qa[0])
-
-
-def mrp_b_matrix(sigma: np.ndarray) -> np.ndarray:
-    """``B(σ) = (1 − σᵀσ) I3 + 2[σ×] + 2σσᵀ`` (σ̇ = ¼ B(σ) ω, seed 001 eq. (1))."""
-    sig = np.asarray(sigma, dtype=float)
-    s = float(sig @ sig)
-    return (1.0 - s) * np.eye(VECTOR_SIZE) + B_CROSS * skew(sig) + B_OUTER * np.outer(sig, sig)
-
-
-def mrp_rate_to_omega(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
-    """Body rate [rad/s] from the MRP rate: ``ω = 4/(1 + σᵀσ)² B(σ)ᵀ σ̇``."""
-    sig = np.asarray(sigma, dtype=float)
-    s = float(sig @ sig)
-    return OMEGA_GAIN / (1.0 + s) ** 2 * (mrp_b_matrix(sig).T @ np.asarray(sigma_dot, float))
-
-
-def mrp_omega_dot(sigma: np.ndarray, sigma_dot: np.ndarray, sigma_ddot: np.ndarray) -> np.ndarray:
-    """Angular acceleration [rad/s²]: the time derivative of :func:`mrp_rate_to_omega`."""
-    sig = np.asarray(sigma, dtype=float)
-    sd = np.asarray(sigma_dot, dtype=float)
-    sdd = np.asarray(sigma_ddot, dtype=float)
-    s = float(sig @ sig)
-    s_dot = 2.0 * float(sig @ sd)
-    b_t = mrp_b_matrix(sig).T
-    b_dot_t = (
-        -s_dot * np.eye(VECTOR_SIZE)
-        - B_CROSS * skew(sd)
-        + B_OUTER * (np.outer(sig, sd) + np.outer(sd, sig))
-    )
-    omega = OMEGA_GAIN / (1.0 + s) ** 2 * (b_t @ sd)
-    return (
-        OMEGA_GAIN / (1.0 + s) ** 2 * (b_dot_t @ sd + b_t @ sdd) - 2.0 * s_dot / (1.0 + s) * omega
-    )
-
-
 def _coeffs(value: object) -> tuple[tuple[float, ...], ...]:
-    expected = "3 non-empty lists of finite numbers (ascending powers of t [s])"
-    if not isinstance(value, Sequence) or isinstance(value, str) or len(value) != VECTOR_SIZE:
-        raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-    out: list[tuple[float, ...]] = []
-    for axis in value:
-        if not isinstance(axis, Sequence) or isinstance(axis, str) or len(axis) == 0:
-            raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-        row: list[float] = []
-        for c in axis:
-            if not (isinstance(c, numbers.Real) and not isinstance(c, bool)):
-                raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-            if not math.isfinite(float(c)):
-                raise ValueError(f"sigma_coeffs = {value!r}: expected {expected}")
-            row.append(float(c))
-        out.append(tuple(row))
-    return tuple(out)
+    """Three non-empty lists of finite coefficients (ConfigError naming ``sigma_coeffs``)."""
+    items = list(value) if isinstance(value, Sequence) and not isinstance(value, str) else []
+    if len(items) != VECTOR_SIZE:
+        raise ConfigError(_SOURCE, "sigma_coeffs", value,
+                          "3 non-empty lists of finite numbers (ascending powers of t [s])")
+    return tuple(check.vector(_SOURCE, "sigma_coeffs", axis, None) for axis in items)
 
 
 def _derivative(coeffs: tuple[float, ...]) -> tuple[float, ...]:
@@ -166,11 +103,8 @@ class MrpPolynomialGuidance:
 
     def __post_init__(self) -> None:
         coeffs = _coeffs(self.sigma_coeffs)
-        if not (isinstance(self.t0_ns, numbers.Integral) and not isinstance(self.t0_ns, bool)):
-            raise ValueError(f"t0_ns = {self.t0_ns!r}: expected an integer [ns]")
-        d = self.duration_s
-        if not (isinstance(d, numbers.Real) and not isinstance(d, bool) and d > 0.0):
-            raise ValueError(f"duration_s = {d!r}: expected a number > 0 [s] (inf allowed)")
+        check.integer(_SOURCE, "t0_ns", self.t0_ns)
+        check.limit(_SOURCE, "duration_s", self.duration_s, unit="s")
         d1 = tuple(_derivative(c) for c in coeffs)
         object.__setattr__(self, "sigma_coeffs", coeffs)
         object.__setattr__(self, "_c", coeffs)
@@ -186,12 +120,11 @@ class MrpPolynomialGuidance:
         tau_s = (t_ns - self.t0_ns) / NS_PER_S
         zero = np.zeros(VECTOR_SIZE)
         if tau_s < 0.0:
-            return AttitudeReference(mrp_to_quaternion(self.sigma(0.0)), zero, zero)
+            return AttitudeReference(mrp.to_quaternion(self.sigma(0.0)), zero, zero)
         if tau_s > self.duration_s:
-            return AttitudeReference(mrp_to_quaternion(self.sigma(self.duration_s)), zero, zero)
+            return AttitudeReference(mrp.to_quaternion(self.sigma(self.duration_s)), zero, zero)
         sig = self.sigma(tau_s)
         sd = np.array([_polyval(c, tau_s) for c in self._d1])
         sdd = np.array([_polyval(c, tau_s) for c in self._d2])
-        return AttitudeReference(
-            mrp_to_quaternion(sig), mrp_rate_to_omega(sig, sd), mrp_omega_dot(sig, sd, sdd)
-        )
+        omega, omega_dot = mrp.omega_and_rate(sig, sd, sdd)
+        return AttitudeReference(mrp.to_quaternion(sig), omega, omega_dot)

@@ -17,23 +17,24 @@ varied w.r.t. time" from an initial attitude of 0, 0, 0 deg: step commands).
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from dbc.errors import ConfigError
+from flight_sw import validation as check
 from flight_sw.guidance.base import QUATERNION_SIZE, VECTOR_SIZE, AttitudeReference
 from flight_sw.quaternion import normalise
 
+_SOURCE = "StepGuidance"
+
 
 def _unit_quaternion(name: str, value: object) -> np.ndarray:
-    arr = np.array(value, dtype=float)
-    if arr.shape != (QUATERNION_SIZE,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} = {value!r}: expected 4 finite numbers (scalar first)")
+    arr = np.array(check.vector(_SOURCE, name, value, QUATERNION_SIZE))
     try:
         return normalise(arr)
     except ValueError:
-        raise ValueError(f"{name} = {value!r}: expected a non-zero quaternion") from None
+        raise ConfigError(_SOURCE, name, value, "a non-zero quaternion") from None
 
 
 @dataclass(frozen=True)
@@ -53,10 +54,7 @@ class StepGuidance:
     _after: AttitudeReference = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        if not (
-            isinstance(self.t_start_ns, numbers.Integral) and not isinstance(self.t_start_ns, bool)
-        ):
-            raise ValueError(f"t_start_ns = {self.t_start_ns!r}: expected an integer [ns]")
+        check.integer(_SOURCE, "t_start_ns", self.t_start_ns)
         hold = _unit_quaternion("q_hold_RN", self.q_hold_RN)
         target = _unit_quaternion("q_target_RN", self.q_target_RN)
         zero = np.zeros(VECTOR_SIZE)

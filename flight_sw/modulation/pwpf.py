@@ -62,26 +62,16 @@ the on-off thrusters; no modulator parameters given there).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 from mypy_extensions import mypyc_attr
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 
 _SOURCE = "PwpfParams"
 # Minimum on-time rule: a wanted emission x with MIN_ON_ROUNDING_FRACTION × min_on_s ≤ x <
 # min_on_s is rounded up to min_on_s, below that down to 0 (nearest, ties up).
 MIN_ON_ROUNDING_FRACTION = 0.5
-
-
-def _real(key: str, value: object, expected: str) -> float:
-    if not (isinstance(value, numbers.Real) and not isinstance(value, bool)):
-        raise ConfigError(_SOURCE, key, value, expected)
-    x = float(value)
-    if not math.isfinite(x):
-        raise ConfigError(_SOURCE, key, value, expected)
-    return x
 
 
 @mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
@@ -104,23 +94,14 @@ class PwpfParams:
     min_on_s: float = 0.0
 
     def __post_init__(self) -> None:
-        km = _real("km", self.km, "a finite number > 0")
-        if km <= 0.0:
-            raise ConfigError(_SOURCE, "km", self.km, "a finite number > 0")
-        tm = _real("tm_s", self.tm_s, "a finite number > 0 [s]")
-        if tm <= 0.0:
-            raise ConfigError(_SOURCE, "tm_s", self.tm_s, "a finite number > 0 [s]")
-        on_expected = f"a finite number in (0, km = {km})"
-        u_on = _real("u_on", self.u_on, on_expected)
-        if not 0.0 < u_on < km:
-            raise ConfigError(_SOURCE, "u_on", self.u_on, on_expected)
-        off_expected = f"a finite number in (u_on − km, u_on) = ({u_on - km}, {u_on})"
-        u_off = _real("u_off", self.u_off, off_expected)
-        if not u_on - km < u_off < u_on:
-            raise ConfigError(_SOURCE, "u_off", self.u_off, off_expected)
-        min_on = _real("min_on_s", self.min_on_s, "a finite number >= 0 [s]")
-        if min_on < 0.0:
-            raise ConfigError(_SOURCE, "min_on_s", self.min_on_s, "a finite number >= 0 [s]")
+        s = _SOURCE
+        km = check.positive(s, "km", self.km)
+        check.positive(s, "tm_s", self.tm_s, unit="s")
+        u_on = check.number(s, "u_on", self.u_on, 0.0, km, lo_open=True,
+                            hi_open=True)
+        check.number(s, "u_off", self.u_off, u_on - km, u_on, lo_open=True,
+                     hi_open=True)
+        check.non_negative(s, "min_on_s", self.min_on_s, unit="s")
 
     @property
     def hysteresis(self) -> float:

@@ -33,10 +33,9 @@ and Rockets, doi:10.2514/1.A33709 (compares the remainder and Schmitt logics).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 
 _SOURCE = "RemainderParams"
 
@@ -52,12 +51,7 @@ class RemainderParams:
     min_on_s: float = 0.0
 
     def __post_init__(self) -> None:
-        v = self.min_on_s
-        expected = "a finite number >= 0 [s]"
-        if not (isinstance(v, numbers.Real) and not isinstance(v, bool)):
-            raise ConfigError(_SOURCE, "min_on_s", v, expected)
-        if not (math.isfinite(float(v)) and float(v) >= 0.0):
-            raise ConfigError(_SOURCE, "min_on_s", v, expected)
+        check.non_negative(_SOURCE, "min_on_s", self.min_on_s, unit="s")
 
 
 class RemainderModulator:

@@ -38,25 +38,15 @@ Schmitt logic with the remainder logic).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
-from dbc.errors import ConfigError
+from flight_sw import validation as check
 
 _SOURCE = "SchmittParams"
 # Default trigger levels (fractions of the minimum fire time), chosen here: fire a
 # minimum pulse once three quarters of it is demanded, stop below one quarter.
 DEFAULT_LEVEL_ON = 0.75
 DEFAULT_LEVEL_OFF = 0.25
-
-
-def _real(key: str, value: object, expected: str) -> float:
-    if not (isinstance(value, numbers.Real) and not isinstance(value, bool)):
-        raise ConfigError(_SOURCE, key, value, expected)
-    x = float(value)
-    if not math.isfinite(x):
-        raise ConfigError(_SOURCE, key, value, expected)
-    return x
 
 
 @dataclass(frozen=True)
@@ -74,17 +64,10 @@ class SchmittParams:
     level_off: float = DEFAULT_LEVEL_OFF
 
     def __post_init__(self) -> None:
-        min_on = _real("min_on_s", self.min_on_s, "a finite number >= 0 [s]")
-        if min_on < 0.0:
-            raise ConfigError(_SOURCE, "min_on_s", self.min_on_s, "a finite number >= 0 [s]")
-        on_expected = "a finite number in (0, 1]"
-        level_on = _real("level_on", self.level_on, on_expected)
-        if not 0.0 < level_on <= 1.0:
-            raise ConfigError(_SOURCE, "level_on", self.level_on, on_expected)
-        off_expected = f"a finite number in [0, level_on = {level_on})"
-        level_off = _real("level_off", self.level_off, off_expected)
-        if not 0.0 <= level_off < level_on:
-            raise ConfigError(_SOURCE, "level_off", self.level_off, off_expected)
+        s = _SOURCE
+        check.non_negative(s, "min_on_s", self.min_on_s, unit="s")
+        level_on = check.number(s, "level_on", self.level_on, 0.0, 1.0, lo_open=True)
+        check.number(s, "level_off", self.level_off, 0.0, level_on, hi_open=True)
 
 
 class SchmittModulator:

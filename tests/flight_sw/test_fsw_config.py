@@ -62,3 +62,16 @@ def test_misspelt_key_is_rejected(cfg: dict[str, Any]) -> None:
     bad["flight_sw"]["estimator"]["gyro_arw"] = 0.1
     with pytest.raises(ConfigError, match=r"flight_sw\.estimator\.gyro_arw"):
         build_computer(bad, PERIOD_NS, IMU_NS, WATCH)
+
+
+def test_every_consumer_gets_each_thrusters_maximum() -> None:
+    """Seed 001's unequal valves (2.35 N, 2.3 N): the pseudo-inverse bounds each thruster by
+    its own maximum, and the flight computer scales each on-time by it."""
+    capture = QUICKSTART.parent / "capture_inertia_identification.toml"
+    cfg = load_scenario(capture).fsw_config()
+    expected = [float(t.get("max_thrust_N", cfg["max_thrust_N"])) for t in cfg["thrusters"]]
+    assert len(set(expected)) > 1  # the layout really is non-uniform
+    fc = build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert isinstance(fc.allocator, PseudoInverseAllocator)
+    assert fc.allocator.bounds_N[1].tolist() == expected
+    assert fc.max_thrust_N.tolist() == expected

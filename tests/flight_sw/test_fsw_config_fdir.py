@@ -108,3 +108,38 @@ def test_empty_thruster_fdir_table_is_an_error(cfg16: dict[str, Any]) -> None:
     with pytest.raises(ConfigError) as info:
         build_computer(bad, PERIOD_NS, IMU_NS, WATCH)
     assert info.value.key == "flight_sw.thruster_fdir"
+
+
+def _residual_fdir(cfg: dict[str, Any]) -> RateResidualFdir:
+    """The rate-residual strategy of the computer built from ``cfg``."""
+    fc = build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert fc.thruster_fdir is not None
+    (found,) = [s for s in fc.thruster_fdir.strategies if isinstance(s, RateResidualFdir)]
+    return found
+
+
+def test_vehicle_valve_timing_is_the_residual_fdirs_default(cfg16: dict[str, Any]) -> None:
+    """The file's valve_timing table sets the model's timing unless the FDIR table says."""
+    table = cfg16["flight_sw"]["thruster_fdir"]["rate_residual"]
+    for key in ("valve_open_delay_s", "valve_tail_tau_s"):
+        del table[key]
+    cfg16["valve_timing"] = {"open_delay_s": 0.004, "tail_tau_s": 0.005, "close_delay_s": 0.001}
+    timing = _residual_fdir(cfg16).model.timing
+    assert (timing.open_delay_s, timing.tail_tau_s) == (0.004, 0.005)  # the vehicle's
+    assert timing.close_delay_s == table["valve_close_delay_s"]  # the FDIR table's
+    cfg16["valve_timing"] = {"open_delay_s": -1.0}
+    with pytest.raises(ConfigError) as info:
+        build_computer(cfg16, PERIOD_NS, IMU_NS, WATCH)
+    assert info.value.key == "valve_timing.open_delay_s"
+
+
+def test_residual_fdir_gets_each_thrusters_maximum(cfg16: dict[str, Any]) -> None:
+    """Per-thruster maxima in the file reach the residual model, thruster by thruster."""
+    maxima = [5.0 if k % 2 else 4.0 for k in range(16)]
+    for entry, m in zip(cfg16["thrusters"], maxima, strict=True):
+        entry["max_thrust_N"] = m
+    fdir = _residual_fdir(cfg16)
+    b = build_computer(cfg16, PERIOD_NS, IMU_NS, WATCH).effectiveness
+    assert b is not None
+    mass_kg = float(cfg16["vehicle"]["mass_kg"])
+    np.testing.assert_array_equal(fdir._res.lin, b[0:3] * (np.array(maxima) / mass_kg))

@@ -200,3 +200,80 @@ def test_configuration_is_validated(
         PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n), [1] * 8)  # type: ignore[list-item]
     with pytest.raises(ConfigError):
         PseudoInverseAllocator(np.full((3, 8), np.nan), PseudoInverseParams(max_thrust_n))
+
+
+# --- per-thruster maxima ---------------------------------------------------------------
+# Seed 001's opposing valves differ by 2.3/2.35; here every other seed-003 thruster is
+# weaker by this factor.
+WEAK_FRACTION = 0.8
+BIND_TOL = 1e-12  # max_i T_i/T_max,i of a scaled (saturated) result is 1 to round-off
+
+
+def per_thruster_maxima(max_thrust_n: float) -> tuple[float, ...]:
+    """T_max for even thrusters, WEAK_FRACTION × T_max for odd ones (8 thrusters)."""
+    return tuple(max_thrust_n * (WEAK_FRACTION if k % 2 else 1.0) for k in range(8))
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_equal_per_thruster_maxima_are_bit_identical_to_one_maximum(
+    layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """A tuple of equal maxima gives exactly the thrusts of the single number (every path)."""
+    b = matrix(layout, rows)
+    one = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n))
+    each = PseudoInverseAllocator(b, PseudoInverseParams((max_thrust_n,) * 8))
+    scale = INFEASIBLE_SCALE * max_thrust_n * float(np.max(np.abs(b)))
+    demands = [b @ t for t in max_thrust_n * rng.integers(0, 2, (N_RANDOM // 5, 8))]
+    demands += list(scale * rng.normal(size=(N_RANDOM // 5, b.shape[0])))
+    demands += list(0.05 * scale * rng.normal(size=(N_RANDOM // 5, b.shape[0])))
+    for d in demands:
+        r1, r2 = one.allocate(d), each.allocate(d)
+        assert np.array_equal(r1.thrust_N, r2.thrust_N) and r1.saturated == r2.saturated
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_per_thruster_maxima_reproduce_attainable_demands(
+    layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """Demands B·T with T_i ∈ [0, T_max,i] (vertices included) are reproduced within bounds."""
+    b = matrix(layout, rows)
+    upper = np.array(per_thruster_maxima(max_thrust_n))
+    alloc = PseudoInverseAllocator(b, PseudoInverseParams(tuple(upper)))
+    samples = np.vstack([rng.uniform(0.0, 1.0, (N_RANDOM, 8)) * upper,
+                         rng.integers(0, 2, (N_RANDOM, 8)) * upper])
+    for t_true in samples:
+        res = alloc.allocate(b @ t_true)
+        assert res.residual_norm <= FEASIBLE_RESIDUAL_TOL and not res.saturated
+        assert np.all(res.thrust_N >= 0.0) and np.all(res.thrust_N <= upper)
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_per_thruster_scaling_binds_one_thruster_and_keeps_direction(
+    layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """Unattainable demands: one thruster exactly at its own maximum, none above, direction kept."""
+    b = matrix(layout, rows)
+    upper = np.array(per_thruster_maxima(max_thrust_n))
+    alloc = PseudoInverseAllocator(b, PseudoInverseParams(tuple(upper)))
+    scale = INFEASIBLE_SCALE * max_thrust_n * float(np.max(np.abs(b)))
+    projector = b @ np.linalg.pinv(b)
+    for demand in scale * rng.normal(size=(N_RANDOM, b.shape[0])):
+        res = alloc.allocate(demand)
+        assert res.saturated and np.all(res.thrust_N <= upper)
+        assert float(np.max(res.thrust_N / upper)) == pytest.approx(1.0, abs=BIND_TOL)
+        target = projector @ demand
+        cos = res.achieved @ target / (np.linalg.norm(res.achieved) * np.linalg.norm(target))
+        assert 1.0 - cos <= DIRECTION_TOL
+
+
+def test_per_thruster_maxima_of_the_wrong_length_are_refused(
+    layout: tuple[np.ndarray, np.ndarray], max_thrust_n: float
+) -> None:
+    """Seven maxima for eight thrusters, or a zero maximum, name the key."""
+    b = matrix(layout, "torque")
+    with pytest.raises(ConfigError) as info:
+        PseudoInverseAllocator(b, PseudoInverseParams((max_thrust_n,) * 7))
+    assert info.value.key == "upper_N"
+    with pytest.raises(ConfigError) as info:
+        PseudoInverseParams((max_thrust_n, 0.0))
+    assert info.value.key == "max_thrust_N"

@@ -10,6 +10,7 @@ with the right kind, quickly, and say nothing before.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -20,6 +21,7 @@ from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.fdir.base import FailureKind, ThrusterFailure
 from flight_sw.fdir.rate_residual import RateResidualFdir, RateResidualParams
 from flight_sw.fdir.thrust_model import ThrustModel
+from flight_sw.fdir.valve_timing import DEFAULT_TIMING
 
 from .conftest import (
     SEED000_ACTUAL_INERTIA_KGM2,
@@ -45,11 +47,17 @@ GYRO_LSB_RAD_S = 2e-5
 ACCEL_SIGMA_M_S2 = 5e-3  # VRW 0.03 m/s/sqrt(h) at 100 Hz
 ACCEL_BIAS_M_S2 = np.array([5e-4, -3e-4, 2e-4])
 TRUTH_EXTRA_DELAY_S = 0.0003  # the truth's command delay differs from the model's
-FSW_DELAY_S, OD_S, CD_S, TR_S, TT_S = 0.0015, 0.003, 0.002, 0.002, 0.003
 DETECT_OPEN_MAX_S = 0.5  # the issue: stuck open within 1 s
 DETECT_CLOSED_MAX_S = 1.0  # the issue: stuck closed within 2 s
 SEED003_MASS_KG = 100.0
 SEED003_ACTUAL_FACTOR = 0.95  # truth inertia and mass 5 % below nominal
+# A non-uniform layout: every other seed-003 thruster has this fraction of the maximum.
+WEAK_FRACTION = 0.7
+
+
+def unequal_maxima(t_max_n: float, n: int) -> np.ndarray:
+    """T_max for even thrusters, WEAK_FRACTION × T_max for odd ones."""
+    return np.array([t_max_n * (WEAK_FRACTION if k % 2 else 1.0) for k in range(n)])
 
 
 def vehicles() -> dict[str, dict[str, object]]:
@@ -60,7 +68,15 @@ def vehicles() -> dict[str, dict[str, object]]:
     return {
         "seed003_8": {
             "b": effectiveness_matrix(r8, d8),
-            "tmax": SEED003_THRUST_N,
+            "tmax": np.full(8, SEED003_THRUST_N),
+            "j_nom": j8,
+            "m_nom": SEED003_MASS_KG,
+            "j_act": SEED003_ACTUAL_FACTOR * j8,
+            "m_act": SEED003_ACTUAL_FACTOR * SEED003_MASS_KG,
+        },
+        "seed003_8_unequal": {
+            "b": effectiveness_matrix(r8, d8),
+            "tmax": unequal_maxima(SEED003_THRUST_N, 8),
             "j_nom": j8,
             "m_nom": SEED003_MASS_KG,
             "j_act": SEED003_ACTUAL_FACTOR * j8,
@@ -68,7 +84,7 @@ def vehicles() -> dict[str, dict[str, object]]:
         },
         "seed000_16": {
             "b": effectiveness_matrix(r16, d16),
-            "tmax": SEED000_THRUST_N,
+            "tmax": np.full(16, SEED000_THRUST_N),
             "j_nom": np.diag(SEED000_NOMINAL_INERTIA_KGM2),
             "m_nom": SEED000_NOMINAL_MASS_KG,
             "j_act": np.diag(SEED000_ACTUAL_INERTIA_KGM2),
@@ -81,22 +97,27 @@ VEHICLES = vehicles()
 
 
 def simulate(
-    name: str, failed: int | None, kind: FailureKind, seed: int
+    name: str, failed: int | None, kind: FailureKind, seed: int,
+    fsw_tmax: np.ndarray | None = None,
 ) -> tuple[list[tuple[int, ThrusterFailure]], list[int], RateResidualFdir]:
-    """Run the strategy against the synthetic truth; (isolations, detection times, strategy)."""
+    """Run the strategy against the synthetic truth; (isolations, detection times, strategy).
+
+    ``fsw_tmax``: the maxima the strategy is told (default: the truth's).
+    """
     v = VEHICLES[name]
     b = np.asarray(v["b"])
     n = b.shape[1]
-    tmax = float(v["tmax"])  # type: ignore[arg-type]
+    tmax = np.asarray(v["tmax"])
     rng = np.random.default_rng(seed)
     n_cycles = round(T_END_S * NS / PERIOD_NS)
     t_fail = round(T_FAIL_S * NS)
     # random commands: fire with probability P_FIRE, on-time 5..20 ms
     fire = rng.random((n_cycles, n)) < P_FIRE
     on = np.where(fire, rng.uniform(MIN_ON_S, PERIOD_NS / NS, (n_cycles, n)), 0.0)
-    truth = ThrustModel(
-        n, MIN_ON_S, FSW_DELAY_S + TRUTH_EXTRA_DELAY_S, OD_S, CD_S, TR_S, TT_S, 10 * NS
+    truth_timing = dataclasses.replace(
+        DEFAULT_TIMING, command_delay_s=DEFAULT_TIMING.command_delay_s + TRUTH_EXTRA_DELAY_S
     )
+    truth = ThrustModel(n, MIN_ON_S, truth_timing, 10 * NS)
     for k in range(n_cycles):
         cmd = on[k].copy()
         if failed is not None and kind == FailureKind.STUCK_CLOSED and k * PERIOD_NS >= t_fail:
@@ -124,17 +145,11 @@ def simulate(
         b,
         np.asarray(v["j_nom"]),
         float(v["m_nom"]),  # type: ignore[arg-type]
-        tmax,
+        tmax if fsw_tmax is None else fsw_tmax,
         MIN_ON_S,
         PERIOD_NS,
         IMU_NS,
-        RateResidualParams(
-            command_delay_s=FSW_DELAY_S,
-            valve_open_delay_s=OD_S,
-            valve_close_delay_s=CD_S,
-            valve_rise_tau_s=TR_S,
-            valve_tail_tau_s=TT_S,
-        ),
+        RateResidualParams(),  # the model's valve timing: the defaults, as the truth's
     )
     isolations: list[tuple[int, ThrusterFailure]] = []
     detections: list[int] = []
@@ -198,3 +213,26 @@ def test_bad_parameters_are_named() -> None:
             RateResidualParams(**{key: value})  # type: ignore[arg-type]
         assert err.value.key == key
     assert math.isfinite(RateResidualParams().threshold)
+
+
+def test_one_top_level_maximum_misreads_a_non_uniform_layout() -> None:
+    """Told one maximum for all (the largest), the weak thrusters look failed: false alarms
+    that the per-thruster maxima above do not raise."""
+    v = VEHICLES["seed003_8_unequal"]
+    top = np.full(8, float(np.max(np.asarray(v["tmax"]))))
+    alarms = 0
+    for seed in range(3):
+        isolations, detections, _ = simulate("seed003_8_unequal", None, FailureKind.NONE,
+                                             seed=seed, fsw_tmax=top)
+        alarms += len(detections) + len(isolations)
+    assert alarms > 0
+
+
+def test_maxima_of_the_wrong_shape_are_refused() -> None:
+    """One number, or n − 1 maxima, for n thrusters: ConfigError naming max_thrust_N."""
+    v = VEHICLES["seed003_8"]
+    for bad in (SEED003_THRUST_N, np.full(7, SEED003_THRUST_N), np.zeros(8)):
+        with pytest.raises(ConfigError) as err:
+            RateResidualFdir(np.asarray(v["b"]), np.asarray(v["j_nom"]), SEED003_MASS_KG,
+                             bad, MIN_ON_S, PERIOD_NS, IMU_NS, RateResidualParams())
+        assert err.value.key == "max_thrust_N"

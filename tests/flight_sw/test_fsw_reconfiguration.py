@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from dbc.errors import ConfigError
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
 from flight_sw.computer import FlightComputer, Timeline
@@ -103,7 +104,7 @@ def computer(b6: np.ndarray, wrench: np.ndarray, fdir: ThrusterFdir) -> FlightCo
         controller=ctl,
         allocator=PseudoInverseAllocator(b6, PseudoInverseParams(SEED000_THRUST_N)),
         modulators=[Proportional() for _ in range(N)],
-        max_thrust_N=SEED000_THRUST_N,
+        max_thrust_N=np.full(N, SEED000_THRUST_N),
         control_period_ns=PERIOD_NS,
         imu_period_ns=IMU_NS,
         timeline=Timeline(identity(), 0, np.zeros(3)),
@@ -185,3 +186,20 @@ def test_stuck_closed_reconfiguration_and_report(layout16: tuple[np.ndarray, np.
     assert (rep.failed_thruster, rep.failure_kind) == (7, FailureKind.STUCK_CLOSED)
     assert rep.detection_time_s == pytest.approx((t_iso - PERIOD_NS) / 1e9)
     assert rep.isolation_delay_s == pytest.approx(PERIOD_NS / 1e9)
+
+
+def test_flight_computer_wants_one_maximum_per_thruster() -> None:
+    """One number, or n − 1 maxima, for n modulators: ConfigError naming max_thrust_N."""
+    with pytest.raises(ConfigError) as info:
+        FlightComputer(
+            estimator=None,  # type: ignore[arg-type]
+            controller=None,  # type: ignore[arg-type]
+            allocator=None,  # type: ignore[arg-type]
+            modulators=[Proportional() for _ in range(N)],
+            max_thrust_N=np.full(N - 1, SEED000_THRUST_N),
+            control_period_ns=PERIOD_NS,
+            imu_period_ns=IMU_NS,
+            timeline=Timeline(identity(), 0),
+            watchdog=SensorWatchdog({}),
+        )
+    assert info.value.key == "max_thrust_N"

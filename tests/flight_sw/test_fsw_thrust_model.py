@@ -8,11 +8,14 @@ import numpy as np
 import pytest
 
 from flight_sw.fdir.thrust_model import ThrustModel
+from flight_sw.fdir.valve_timing import DEFAULT_TIMING
 
 N = 4
 NS = 1_000_000_000
 MIN_ON_S = 0.005
-DELAY_S, OD_S, CD_S, TR_S, TT_S = 0.0015, 0.003, 0.002, 0.002, 0.003
+T = DEFAULT_TIMING  # the fdir_16thr valve data
+DELAY_S, OD_S, CD_S = T.command_delay_s, T.open_delay_s, T.close_delay_s
+TR_S, TT_S = T.rise_tau_s, T.tail_tau_s
 HORIZON_NS = 2 * NS
 IMPULSE_TOL_S = 1e-9
 PERIOD_NS = 20_000_000
@@ -20,7 +23,7 @@ PERIOD_NS = 20_000_000
 
 def model() -> ThrustModel:
     """A 4-thruster model with the fdir_16thr valve data."""
-    return ThrustModel(N, MIN_ON_S, DELAY_S, OD_S, CD_S, TR_S, TT_S, HORIZON_NS)
+    return ThrustModel(N, MIN_ON_S, DEFAULT_TIMING, HORIZON_NS)
 
 
 def pulse_thrust_time_s(on_s: float) -> float:

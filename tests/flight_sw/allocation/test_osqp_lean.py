@@ -6,8 +6,7 @@ import numpy as np
 import osqp
 import scipy.sparse as sp
 
-from flight_sw.allocation.osqp_lean import LeanOsqp
-from flight_sw.allocation.qp_osqp import osqp_settings
+from flight_sw.allocation.osqp_lean import LeanOsqp, osqp_settings
 
 N_VARS = 8
 N_ROWS = 3

@@ -9,7 +9,8 @@ import pytest
 from scipy.optimize import lsq_linear
 
 from dbc.errors import ConfigError
-from flight_sw.allocation.qp_osqp import FREE, BoundedQpAllocator, BoundedQpParams, box_qp
+from flight_sw.allocation.active_set import FREE, box_qp
+from flight_sw.allocation.qp_osqp import BoundedQpAllocator, BoundedQpParams
 
 N_RANDOM = 60
 T_MAX_N = 5.0

@@ -10,6 +10,8 @@ import pytest
 from flight_sw import quaternion as quat
 from flight_sw.control import anti_unwinding as au
 
+from .dq_reference import au_jacobian, au_jacobian_rate
+
 MU = 0.01
 LAMBDA1 = 1.0
 LAMBDA2 = 1.0
@@ -81,3 +83,24 @@ def test_axis_gain_vanishes_at_the_maximum_of_the_error_norm() -> None:
     assert au.axis_gain(_q_of_angle(theta_max - 2 * step), MU) > 0.0
     assert au.axis_gain(_q_of_angle(theta_max + 2 * step), MU) < 0.0
     assert math.degrees(theta_max) == pytest.approx(103.1, abs=0.1)
+
+
+ARRAY_FORM_RTOL = 1e-14  # the float form against the array form: round-off only
+
+
+def _close(got: object, want: np.ndarray) -> None:
+    """Equal to ARRAY_FORM_RTOL of the larger of 1 and the reference's largest entry."""
+    scale = max(1.0, float(np.max(np.abs(want))))
+    np.testing.assert_allclose(np.reshape(np.asarray(got), want.shape), want, rtol=0.0,
+                               atol=ARRAY_FORM_RTOL * scale)
+
+
+def test_float_error_state_equals_the_array_form(rng: np.random.Generator) -> None:
+    """error_state's e_r, Θ_r, Θ̇_r equal the matrix expressions (dq_reference) to round-off."""
+    for _ in range(200):
+        q = quat.normalise(rng.normal(size=4))
+        w = rng.normal(size=3)
+        er, jac, rate = au.error_state(*q.tolist(), tuple(w.tolist()), MU)
+        _close(er, au.error_vector(q, MU))
+        _close(jac, au_jacobian(q, MU))
+        _close(rate, au_jacobian_rate(q, w, MU))

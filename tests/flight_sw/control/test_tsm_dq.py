@@ -10,11 +10,16 @@ from flight_sw import quaternion as quat
 from flight_sw.control.nftsm_dq import PAPER_MEAN_MOTION_RAD_S
 from flight_sw.control.tsm_dq import TsmDq, TsmDqParams
 
+from .dq_reference import tsm_wrench_reference
+
 ZERO3 = np.zeros(3)
 ZERO_WRENCH_TOL = 1e-9
 TINY_ERRORS = (1e-3, 1e-6, 1e-9, 1e-12)
 INITIAL_Q = np.array([0.6245, 0.5, 0.5196, 0.3])
 INITIAL_POSITION_M = np.array([-20.0, -10.0, -10.0])
+N_LAW_CASES = 300
+LAW_RTOL = 1e-9  # the float form against the array form: round-off of different orders
+SEED_LAW = 13
 
 
 @pytest.mark.parametrize("n", [0.0, PAPER_MEAN_MOTION_RAD_S])
@@ -61,3 +66,24 @@ def test_params_reject_bad_values(key: str, value: object) -> None:
     """TsmDqParams raises ConfigError naming the bad key."""
     with pytest.raises(ConfigError, match=key):
         TsmDqParams(**{key: value})  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("anti_unwinding", [False, True])
+@pytest.mark.parametrize("n", [0.0, PAPER_MEAN_MOTION_RAD_S])
+def test_float_law_equals_the_array_reference(anti_unwinding: bool, n: float) -> None:
+    """wrench_B (floats) equals the paper's terms composed as arrays (dq_reference) on random
+    poses, twists and references, with and without orbit terms and anti-unwinding."""
+    rng = np.random.default_rng(SEED_LAW)
+    law = TsmDq(TsmDqParams(mean_motion_rad_s=n, anti_unwinding=anti_unwinding,
+                            inertia_B_kgm2=(18.0, 19.0, 24.0), max_force_N=300.0))
+    law.set_inertia_B_kgm2(np.array([[18.0, 0.4, 0.1], [0.4, 19.0, -0.3], [0.1, -0.3, 24.0]]))
+    for _ in range(N_LAW_CASES):
+        q = quat.normalise(rng.normal(size=4))
+        q_ref = (quat.multiply(q, quat.from_rotation_vector(rng.normal(size=3) * 0.4))
+                 if anti_unwinding else quat.normalise(rng.normal(size=4)))
+        args = (0, q, rng.normal(size=3) * 0.1, rng.normal(size=3) * 10.0,
+                rng.normal(size=3) * 0.1, q_ref, rng.normal(size=3) * 0.01,
+                rng.normal(size=3), rng.normal(size=3) * 0.01)
+        ref = tsm_wrench_reference(law, *args)
+        np.testing.assert_allclose(law.wrench_B(*args), ref, rtol=0.0,
+                                   atol=LAW_RTOL * max(1.0, float(np.abs(ref).max())))

@@ -11,10 +11,11 @@ from dbc.errors import ConfigError
 from flight_sw.estimation.rls_inertia import (
     RlsInertiaIdentifier,
     RlsInertiaParams,
-    euler_regressor,
     inertia_matrix,
     inertia_params,
 )
+
+from .rls_reference import euler_regressor
 
 # A full tensor (products of inertia included), seed 001 §5 principal moments 25, 20, 15.
 J_TRUE = np.array([[25.0, 1.2, -0.8], [1.2, 20.0, 0.5], [-0.8, 0.5, 15.0]])

@@ -2,8 +2,10 @@
 
 Back to back on random inputs of the identifier's sizes: the written-out gyroscopic
 regressor, the window equation (one period and a 50-period window), the RLS step with and
-without the trace bound, and the Cholesky gates against eigenvalues; an ill-conditioned
-step is handed back (None) to the numpy form, and the identifier then takes it there.
+without the trace bound, and the Cholesky gates against eigenvalues. An innovation matrix
+too ill-conditioned for Cholesky is solved by the kernel's own SVD path (equal to the
+reference's LU solve where the data determine the answer); a non-finite step is refused,
+and the identifier counts both.
 """
 
 from __future__ import annotations
@@ -17,13 +19,16 @@ from flight_sw.estimation import rls_inertia, rls_kernel
 from flight_sw.estimation.rls_inertia import (
     RlsInertiaIdentifier,
     RlsInertiaParams,
-    euler_regressor,
     inertia_params,
+)
+from flight_sw.quaternion import skew
+
+from .rls_reference import (
+    euler_regressor,
     momentum_regressor,
     rls_step_reference,
     window_equation_reference,
 )
-from flight_sw.quaternion import skew
 
 SEED = 20261204
 CASES = 200
@@ -33,6 +38,11 @@ RATE_SCALE_RAD_S = 0.05
 TORQUE_SCALE_NM = 2.0
 REGRESSOR_RTOL = 1e-12  # two summation orders of the same sums
 STEP_RTOL = 1e-9  # LU vs Cholesky solve of S (condition up to ~1e6 here)
+# LU vs Jacobi SVD of an S of condition ~1e15: the step's parts the data determine agree to
+# round-off (measured ~6e-16), relative to each result's largest entry.
+SINGULAR_STEP_RTOL = 1e-12
+SINGULAR_COVARIANCE = 1e16  # P = this × I: λ within round-off of Φ P Φᵀ (~6e14)
+NO_TRACE_CAP = 1e30
 EIG_MARGIN = 1e-6  # relative distance from the gate's threshold kept by the random cases
 WINDOWS = (1, 50)
 J_GUESS = np.diag([20.0, 20.0, 20.0])
@@ -94,20 +104,54 @@ def test_rls_step_equals_reference(trace_cap: float) -> None:
         out = rls_kernel.rls_step(
             p.tolist(), theta.tolist(), info.tolist(), phi.tolist(), y.tolist(), lam, trace_cap
         )
-        assert out is not None
-        for got, want in zip(out, ref, strict=True):
+        assert out is not None and not out[3]  # the Cholesky path
+        for got, want in zip(out[:3], ref, strict=True):
             assert _close(got, want, STEP_RTOL)
         assert np.array_equal(np.array(out[0]), np.array(out[0]).T)  # P exactly symmetric
 
 
-def test_rls_step_hands_back_an_indefinite_innovation_matrix() -> None:
-    """``S`` not positive definite (an invalid, negative P): None, numpy's form decides."""
+def test_rls_step_solves_a_numerically_singular_innovation_matrix() -> None:
+    """Two identical regressor rows and a huge P: S fails the Cholesky gate; the kernel's SVD
+    path still gives the reference's step (consistent measurements: y = Φ θ*)."""
+    rng = np.random.default_rng(SEED)
+    row = rng.normal(size=6) * 1e-1
+    for _ in range(CASES // 10):
+        phi = np.vstack([row, row, rng.normal(size=6) * 1e-1])
+        p = SINGULAR_COVARIANCE * np.eye(6)
+        lam = float(rng.uniform(0.95, 1.0))
+        theta = rng.normal(size=6) * 20.0
+        y = phi @ (theta + rng.normal(size=6))
+        info = _spd(rng, 6, 1e-2)
+        out = rls_kernel.rls_step(p.tolist(), theta.tolist(), info.tolist(), phi.tolist(),
+                                  y.tolist(), lam, NO_TRACE_CAP)
+        assert out is not None and out[3]  # S failed the Cholesky gate: the SVD path
+        ref = rls_step_reference(p, theta, info, phi, y, lam, NO_TRACE_CAP)
+        for got, want in zip(out[:3], ref, strict=True):
+            assert _close(got, want, SINGULAR_STEP_RTOL)
+
+
+def test_rls_step_solves_an_indefinite_innovation_matrix() -> None:
+    """``S`` indefinite (an invalid, negative P) but non-singular: the SVD path inverts it
+    exactly as LAPACK's LU does."""
     rng = np.random.default_rng(SEED)
     phi = rng.normal(size=(3, 6))
     p = -1e3 * np.eye(6)
-    out = rls_kernel.rls_step(
-        p.tolist(), [1.0] * 6, np.zeros((6, 6)).tolist(), phi.tolist(), [0.0] * 3, 0.99, 1e30
-    )
+    theta, y, info = np.ones(6), rng.normal(size=3), np.zeros((6, 6))
+    out = rls_kernel.rls_step(p.tolist(), theta.tolist(), info.tolist(), phi.tolist(),
+                              y.tolist(), 0.99, NO_TRACE_CAP)
+    assert out is not None and out[3]
+    ref = rls_step_reference(p, theta, info, phi, y, 0.99, NO_TRACE_CAP)
+    for got, want in zip(out[:3], ref, strict=True):
+        assert _close(got, want, STEP_RTOL)
+
+
+def test_rls_step_refuses_a_non_finite_result() -> None:
+    """A covariance at the edge of the float range overflows the step: None (refused)."""
+    rng = np.random.default_rng(SEED)
+    phi = rng.normal(size=(3, 6)) * 1e3
+    p = 1e307 * np.eye(6)
+    out = rls_kernel.rls_step(p.tolist(), [1.0] * 6, np.zeros((6, 6)).tolist(), phi.tolist(),
+                              [1.0, 2.0, 3.0], 0.99, NO_TRACE_CAP)
     assert out is None
 
 
@@ -125,10 +169,9 @@ def test_exceeds_matches_the_smallest_eigenvalue() -> None:
         assert rls_kernel.exceeds(a.tolist(), m) == (lam_min > m)
 
 
-def test_identifier_uses_the_reference_step_when_the_kernel_declines(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    """With the kernel's step refused every time, the identifier's estimates are unchanged."""
+def test_identifier_counts_svd_and_refused_steps(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Steps taken by the SVD path are counted and used; refused steps are counted and
+    skipped (the estimate keeps its value)."""
     rng = np.random.default_rng(SEED)
     omega = RATE_SCALE_RAD_S * rng.normal(size=(N_CYCLES, 3))
     theta_true = inertia_params(J_TRUE)
@@ -139,16 +182,21 @@ def test_identifier_uses_the_reference_step_when_the_kernel_declines(
     ]
     params = RlsInertiaParams(inertia_guess_B_kgm2=J_GUESS, min_information=0.0)
 
-    def run() -> list[np.ndarray | None]:
+    def run() -> tuple[RlsInertiaIdentifier, list[np.ndarray | None]]:
         ident = RlsInertiaIdentifier(params)
-        return [ident.update(k * PERIOD_NS, omega[k], torque[k]) for k in range(N_CYCLES)]
+        return ident, [ident.update(k * PERIOD_NS, omega[k], torque[k]) for k in range(N_CYCLES)]
 
-    fast = run()
+    step = rls_kernel.rls_step
+    ident, plain = run()
+    assert (ident.n_svd_steps, ident.n_refused_steps) == (0, 0)
+    assert plain[-1] is not None and _close(plain[-1], J_TRUE, STEP_RTOL)
+    monkeypatch.setattr(rls_inertia.kernel, "rls_step",
+                        lambda *args: (*step(*args)[:3], True))  # type: ignore[misc]
+    ident, flagged = run()
+    assert ident.n_svd_steps == ident.n_updates == N_CYCLES - 1
+    assert all(np.array_equal(a, b) for a, b in zip(plain[1:], flagged[1:], strict=True))
     monkeypatch.setattr(rls_inertia.kernel, "rls_step", lambda *args: None)
-    slow = run()
-    assert [j is None for j in fast] == [j is None for j in slow]
-    assert fast[-1] is not None and slow[-1] is not None
-    for a, b in zip(fast, slow, strict=True):
-        if a is not None and b is not None:
-            assert _close(a, b, STEP_RTOL)
-    assert _close(fast[-1], J_TRUE, STEP_RTOL)
+    ident, refused = run()
+    assert ident.n_refused_steps == N_CYCLES - 1 and ident.n_updates == 0
+    assert all(j is None for j in refused)
+    np.testing.assert_array_equal(ident.inertia_B_kgm2, J_GUESS)

@@ -1,22 +1,17 @@
-"""Tests of the polynomial MRP guidance (seed 001 §5 trajectory) and its MRP helpers."""
+"""Tests of the polynomial MRP guidance (seed 001 §5 trajectory) and the MRP rates it uses."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from flight_sw.guidance.mrp_polynomial import (
-    SEED001_DURATION_S,
-    MrpPolynomialGuidance,
-    mrp_b_matrix,
-    mrp_rate_to_omega,
-    mrp_to_quaternion,
-    quaternion_to_mrp,
-)
+from flight_sw import mrp
+from flight_sw.guidance.mrp_polynomial import SEED001_DURATION_S, MrpPolynomialGuidance
 from flight_sw.quaternion import (
     conjugate,
     from_rotation_vector,
     multiply,
+    skew,
     to_dcm,
 )
 
@@ -30,6 +25,26 @@ FD_RATE_TOL = 1e-8  # [rad/s]
 FD_ACCEL_TOL = 1e-8  # [rad/s²]
 ROUND_TRIP_TOL = 1e-14
 REST_RATE_TOL = 1e-2  # [rad/s]: the seed's trajectory nearly stops at 100 s
+B_FORM_RTOL = 1e-14  # mrp's F⁻¹ forms against the B-matrix textbook form: round-off only
+
+
+def b_matrix(sigma: np.ndarray) -> np.ndarray:
+    """Schaub & Junkins' ``B(σ) = (1 − s) I + 2[σ×] + 2σσᵀ`` (σ̇ = ¼ B ω)."""
+    s = float(sigma @ sigma)
+    return (1.0 - s) * np.eye(3) + 2.0 * skew(sigma) + 2.0 * np.outer(sigma, sigma)
+
+
+def omega_b_form(sigma: np.ndarray, sd: np.ndarray, sdd: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """``ω = 4/(1+s)² Bᵀσ̇`` and ``ω̇ = 4/(1+s)² (Ḃᵀσ̇ + Bᵀσ̈) − 2ṡ/(1+s) ω``, the textbook
+    form (the guidance's own before it used flight_sw.mrp)."""
+    s, s_dot = float(sigma @ sigma), 2.0 * float(sigma @ sd)
+    omega = 4.0 / (1.0 + s) ** 2 * (b_matrix(sigma).T @ sd)
+    outer = np.outer(sigma, sd) + np.outer(sd, sigma)
+    b_dot_t = -s_dot * np.eye(3) - 2.0 * skew(sd) + 2.0 * outer
+    omega_dot = (4.0 / (1.0 + s) ** 2 * (b_dot_t @ sd + b_matrix(sigma).T @ sdd)
+                 - 2.0 * s_dot / (1.0 + s) * omega)
+    return omega, omega_dot
 
 
 def numeric_rate(g: MrpPolynomialGuidance, t_ns: int) -> np.ndarray:
@@ -45,7 +60,7 @@ def test_starts_at_seed_initial_mrp() -> None:
     """At t0 the reference quaternion is that of the seed's initial MRP."""
     g = MrpPolynomialGuidance(t0_ns=T0_NS)
     q = g.reference(T0_NS).q_RN
-    np.testing.assert_allclose(quaternion_to_mrp(q), SEED001_SIGMA0, rtol=0.0, atol=1e-15)
+    np.testing.assert_allclose(mrp.from_quaternion(q), SEED001_SIGMA0, rtol=0.0, atol=1e-15)
 
 
 @pytest.mark.parametrize("t_s", SAMPLE_TIMES_S)
@@ -70,15 +85,29 @@ def test_acceleration_matches_numerical_rate_derivative(t_s: float) -> None:
 
 
 def test_mrp_kinematics_round_trip() -> None:
-    """σ̇ = ¼ B(σ) ω inverts ω = 4/(1+σ²)² Bᵀ σ̇ (seed 001 eq. (1) and F⁻¹)."""
+    """σ̇ = ¼ B(σ) ω inverts ω = F⁻¹(σ) σ̇ (seed 001 eq. (1) and F⁻¹)."""
     rng = np.random.default_rng(5)
     for _ in range(20):
         sigma = rng.uniform(-0.6, 0.6, 3)
         omega = rng.normal(0.0, 0.1, 3)
-        sigma_dot = 0.25 * mrp_b_matrix(sigma) @ omega
+        sigma_dot = 0.25 * b_matrix(sigma) @ omega
         np.testing.assert_allclose(
-            mrp_rate_to_omega(sigma, sigma_dot), omega, rtol=0.0, atol=ROUND_TRIP_TOL
+            mrp.rate_to_omega(sigma, sigma_dot), omega, rtol=0.0, atol=ROUND_TRIP_TOL
         )
+
+
+def test_rates_equal_the_b_matrix_form() -> None:
+    """ω and ω̇ from flight_sw.mrp (F⁻¹, Ḟ) equal the B-matrix form to round-off."""
+    rng = np.random.default_rng(6)
+    for _ in range(50):
+        sigma, sd, sdd = rng.uniform(-0.6, 0.6, 3), rng.normal(0, 0.05, 3), rng.normal(0, 0.01, 3)
+        omega, omega_dot = omega_b_form(sigma, sd, sdd)
+        np.testing.assert_allclose(mrp.rate_to_omega(sigma, sd), omega, rtol=0.0,
+                                   atol=B_FORM_RTOL * max(1.0, float(np.abs(omega).max())))
+        got_omega, got_omega_dot = mrp.omega_and_rate(sigma, sd, sdd)
+        assert np.array_equal(got_omega, mrp.rate_to_omega(sigma, sd))
+        np.testing.assert_allclose(got_omega_dot, omega_dot, rtol=0.0,
+                                   atol=B_FORM_RTOL * max(1.0, float(np.abs(omega_dot).max())))
 
 
 def test_mrp_quaternion_conventions() -> None:
@@ -87,8 +116,8 @@ def test_mrp_quaternion_conventions() -> None:
     angle = 1.3
     q = from_rotation_vector(angle * axis)
     sigma = axis * np.tan(angle / 4.0)
-    np.testing.assert_allclose(mrp_to_quaternion(sigma), q, rtol=0.0, atol=ROUND_TRIP_TOL)
-    np.testing.assert_allclose(quaternion_to_mrp(-q), sigma, rtol=0.0, atol=ROUND_TRIP_TOL)
+    np.testing.assert_allclose(mrp.to_quaternion(sigma), q, rtol=0.0, atol=ROUND_TRIP_TOL)
+    np.testing.assert_allclose(mrp.from_quaternion(-q), sigma, rtol=0.0, atol=ROUND_TRIP_TOL)
     # Schaub & Junkins: C(σ) = I + (8[σ×]² − 4(1 − σ²)[σ×])/(1 + σ²)²
     s = float(sigma @ sigma)
     sx = np.array([[0, -sigma[2], sigma[1]], [sigma[2], 0, -sigma[0]], [-sigma[1], sigma[0], 0]])
@@ -123,7 +152,7 @@ def test_custom_constant_coefficients_give_fixed_attitude() -> None:
     """Constant polynomials give a fixed attitude and zero rates."""
     g = MrpPolynomialGuidance(sigma_coeffs=[[0.1], [0.0], [-0.2]], duration_s=float("inf"))
     ref = g.reference(123 * NS_PER_S)
-    np.testing.assert_allclose(quaternion_to_mrp(ref.q_RN), [0.1, 0.0, -0.2], atol=1e-15)
+    np.testing.assert_allclose(mrp.from_quaternion(ref.q_RN), [0.1, 0.0, -0.2], atol=1e-15)
     np.testing.assert_array_equal(ref.omega_RN_R, np.zeros(3))
 
 

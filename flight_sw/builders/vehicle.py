@@ -1,0 +1,124 @@
+"""The nominal vehicle the flight-software strategies are built from, and shared helpers.
+
+What it does: :class:`Vehicle` reads the configuration file's vehicle data (nominal mass
+[kg] and inertia [kg m²], the thrusters' positions [m] and directions in body axes, the
+maximum thrust of each thruster [N] — one top-level number, or each thruster its own —
+the minimum on-time [s] and the optional ``valve_timing`` table of the valve data),
+builds the effectiveness matrix and records which demand rows the allocator gets (torque,
+or the full wrench in 6 DoF). The helpers read the table forms several builder families
+share (a matrix, an optional rate limit, a dataclass whose every field is optional).
+
+Inputs: :class:`dbc.schema.Table` views of the configuration (errors name the file and
+the dotted key). Units: as the field names say; angles in the file are in degrees.
+
+Source: project convention (``flight_sw`` configuration file, ``docs/scenarios.md``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from dbc.schema import Table
+from flight_sw import validation as check
+from flight_sw.allocation.effectiveness import effectiveness_matrix
+from flight_sw.fdir.valve_timing import DEFAULT_TIMING, ValveTiming
+
+DEG_RAD = math.pi / 180.0
+ARCSEC_RAD = DEG_RAD / 3600.0
+SQRT_HOUR_S = 60.0
+NS_PER_S = 1_000_000_000
+TORQUE_ROWS = slice(3, 6)
+WRENCH_ROWS = slice(0, 6)
+
+
+class Vehicle:
+    """Nominal vehicle data the strategies are built from."""
+
+    def __init__(self, t: Table, root: Table) -> None:
+        self.mass_kg = t.number("mass_kg", lo=0.0, lo_open=True)
+        self.inertia_B_kgm2 = np.array(t.matrix3("inertia_B_kgm2"))
+        t.done()
+        thr = root.tables("thrusters")
+        if not thr:
+            raise root.error("thrusters", [], "at least one thruster")
+        self.r_thr_B_m = np.array([x.vector("r_thr_B_m", 3) for x in thr])
+        self.d_thr_B = np.array([x.vector("d_thr_B", 3) for x in thr])
+        # one maximum for all, or each thruster its own (e.g. seed 001's opposing valves of
+        # unequal bounds); every consumer gets the per-thruster vector (n,) [N]
+        default_N = root.number("max_thrust_N", lo=0.0, lo_open=True)
+        self.max_thrust_each_N = np.array(
+            [x.number("max_thrust_N", default_N, lo=0.0, lo_open=True) for x in thr]
+        )
+        for x in thr:
+            x.done()
+        self.min_on_s = root.number("min_on_s", lo=0.0)
+        self.valve_timing = valve_timing(root)
+        self.effectiveness = effectiveness_matrix(self.r_thr_B_m, self.d_thr_B)
+        self.demand_rows = TORQUE_ROWS  # WRENCH_ROWS once a translation controller is set
+        self.control_period_ns = 0
+        self.imu_period_ns = 0
+
+
+def valve_timing(root: Table) -> ValveTiming:
+    """The vehicle's valve timing from the optional ``valve_timing`` table (each key
+    optional; defaults: :mod:`flight_sw.fdir.valve_timing`)."""
+    if not root.has("valve_timing"):
+        return DEFAULT_TIMING
+    t = root.table("valve_timing")
+    d = DEFAULT_TIMING
+    timing = ValveTiming(
+        command_delay_s=t.number("command_delay_s", d.command_delay_s, lo=0.0),
+        open_delay_s=t.number("open_delay_s", d.open_delay_s, lo=0.0),
+        close_delay_s=t.number("close_delay_s", d.close_delay_s, lo=0.0),
+        rise_tau_s=t.number("rise_tau_s", d.rise_tau_s, lo=0.0),
+        tail_tau_s=t.number("tail_tau_s", d.tail_tau_s, lo=0.0),
+    )
+    t.done()
+    return timing
+
+
+def max_rate(t: Table) -> float:
+    """Optional ``max_rate_deg_s`` in rad/s (inf when absent)."""
+    if not t.has("max_rate_deg_s"):
+        return math.inf
+    return t.number("max_rate_deg_s", lo=0.0, lo_open=True) * DEG_RAD
+
+
+def matrix(t: Table, key: str, rows: int, cols: int) -> np.ndarray:
+    """The ``rows``×``cols`` matrix of finite numbers at ``key`` (ConfigError naming it)."""
+    return check.matrix(t.source, f"{t.path}.{key}" if t.path else key, t.raw(key), rows, cols)
+
+
+def dataclass_params(t: Table, cls: Any, defaults: dict[str, Any]) -> Any:
+    """``cls`` built from the table: every field optional, read by its default's type."""
+    kwargs: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        default = defaults.get(f.name, f.default)
+        if not t.has(f.name):
+            kwargs[f.name] = default
+        elif isinstance(default, bool):
+            value = t.raw(f.name)
+            if not isinstance(value, bool):
+                raise t.error(f.name, value, "true or false")
+            kwargs[f.name] = value
+        elif isinstance(default, tuple):
+            kwargs[f.name] = t.vector3(f.name)
+        else:
+            kwargs[f.name] = t.number(f.name)
+    return cls(**kwargs)
+
+
+def nominal_mass(v: Vehicle) -> dict[str, Any]:
+    j = v.inertia_B_kgm2
+    return {
+        "mass_kg": v.mass_kg,
+        "inertia_B_kgm2": (float(j[0, 0]), float(j[1, 1]), float(j[2, 2])),
+    }
+
+
+def upper_N(v: Vehicle) -> tuple[float, ...]:
+    return tuple(float(x) for x in v.max_thrust_each_N)
