@@ -28,7 +28,6 @@ naming the file, so neither side misreads a newer one. docs/icd.md has the field
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -42,6 +41,7 @@ STATS_SCHEMA = "thruster-hil/fsw-stats"
 VERSION = 1
 EXIT_REFUSED = 2  # the flight software's exit code when it refuses its configuration
 UNIT_NORM_TOL = 1e-6
+VALVE_KEYS = ("min_on_s", "open_delay_s", "close_delay_s", "rise_tau_s", "tail_tau_s")
 MANOEUVRE_KINDS = ("step", "mrp_polynomial")
 # statistics fields the bench reads (all optional): see docs/icd.md
 STATS_FIELDS = ("cycles", "overruns", "sent", "received", "second_sender_evidence", "mode",
@@ -72,20 +72,23 @@ class ThrusterConfig:
 
 @dataclass(frozen=True)
 class ValveTiming:
-    """The valve drive electronics' timing [s]: pulses shorter than ``min_on_s`` are
-    extended to it; thrust follows a command by ``open_delay_s`` and stops
-    ``close_delay_s`` after its end."""
+    """The valves' nominal timing [s]: pulses shorter than ``min_on_s`` are extended to it
+    by the drive electronics; the valve starts opening ``open_delay_s`` after a command's
+    receipt and closing ``close_delay_s`` after its end; thrust rises and decays with the
+    first-order time constants ``rise_tau_s`` and ``tail_tau_s``."""
 
     min_on_s: float
     open_delay_s: float
     close_delay_s: float
+    rise_tau_s: float
+    tail_tau_s: float
 
 
 @dataclass(frozen=True)
 class Manoeuvre:
     """The reference: hold until ``t_start_s``, then ``q_target_BN`` (a step), or follow an
-    MRP polynomial (``mrp_coefficients``, one row per axis, ascending powers of time since
-    the start [s]); ``q_target_BN`` is then its attitude at the end of the run."""
+    MRP polynomial (``mrp_coefficients``: one row per axis, highest power first, in the
+    time since the start [s]); ``q_target_BN`` is then its attitude at the end of the run."""
 
     q_target_BN: tuple[float, float, float, float]
     t_start_s: float
@@ -130,7 +133,9 @@ class FswConfig:
                            "max_thrust_N": t.max_thrust_N} for t in self.thrusters],
             "valves": {"min_on_s": self.valves.min_on_s,
                        "open_delay_s": self.valves.open_delay_s,
-                       "close_delay_s": self.valves.close_delay_s},
+                       "close_delay_s": self.valves.close_delay_s,
+                       "rise_tau_s": self.valves.rise_tau_s,
+                       "tail_tau_s": self.valves.tail_tau_s},
             "manoeuvre": man,
             "flight_sw": self.flight_sw,
         }
@@ -151,8 +156,7 @@ class FswConfig:
                                             t.number("max_thrust_N", lo=0.0, lo_open=True)))
             t.done()
         vl = root.table("valves")
-        valves = ValveTiming(vl.number("min_on_s", lo=0.0), vl.number("open_delay_s", lo=0.0),
-                             vl.number("close_delay_s", lo=0.0))
+        valves = ValveTiming(*(vl.number(k, lo=0.0) for k in VALVE_KEYS))
         vl.done()
         mt = root.table("manoeuvre")
         kind = mt.string("kind", "step", choices=MANOEUVRE_KINDS)
@@ -168,6 +172,19 @@ class FswConfig:
             raise root.error("flight_sw", fsw, "a table")
         root.done()
         return cls(origin, mass, inertia, tuple(thrusters), valves, man, fsw)  # type: ignore[arg-type]
+
+
+def _json_safe(x: Any) -> bool:
+    """``x`` is made of JSON's types only (finite numbers)."""
+    if x is None or isinstance(x, (bool, int, str)):
+        return True
+    if isinstance(x, float):
+        return math.isfinite(x)
+    if isinstance(x, (list, tuple)):
+        return all(_json_safe(v) for v in x)
+    if isinstance(x, dict):
+        return all(isinstance(k, str) and _json_safe(v) for k, v in x.items())
+    return False
 
 
 @dataclass(frozen=True)
@@ -191,10 +208,7 @@ class FswRefusal:
 
     def to_json(self) -> dict[str, Any]:
         """The record (the value as JSON allows, else its text)."""
-        try:
-            value: Any = json.loads(json.dumps(self.value))
-        except (TypeError, ValueError):
-            value = repr(self.value)
+        value = self.value if _json_safe(self.value) else repr(self.value)
         return {"schema": REFUSAL_SCHEMA, "version": VERSION, "source": self.source,
                 "key": self.key, "value": value, "expected": self.expected,
                 "message": self.message}

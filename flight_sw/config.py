@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from dbc.contract import FswConfig
 from dbc.errors import ConfigError
 from dbc.schema import Table
 from flight_sw.allocation.base import Allocator
@@ -142,10 +143,12 @@ def build_computer(
 ) -> FlightComputer:
     """Build the flight computer described by the configuration ``cfg``."""
     source = str(cfg.get("source", "<flight-software config>"))
+    FswConfig.from_json(cfg, source)  # the contract's schema, version and vehicle data
     root = Table(cfg, source)
+    root.raw("schema")
+    root.raw("version")
     root.raw("source", "")
     vehicle = Vehicle(root.table("vehicle"), root)
-    root.string("valve_model", "on_off", choices=("on_off", "throttled"))  # the bench's
     man = root.table("manoeuvre")
     kind = man.string("kind", "step", choices=("step", *GUIDANCE))
     q_target = np.array(man.vector("q_target_BN", 4))

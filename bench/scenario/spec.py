@@ -20,6 +20,7 @@ from bench.station.dynamics.hcw import SEED000_ORBIT_RADIUS_M
 from bench.station.environment.disturbance import DisturbanceParams
 from bench.station.faults import FaultSpec
 from bench.station.reference import KIND_STEP, ReferenceParams
+from dbc.contract import FswConfig, Manoeuvre, ThrusterConfig, ValveTiming
 
 FSW_TABLE = "flight_sw"  # the table passed through to the flight software
 TRANSLATIONS = ("inertial", "hcw")
@@ -196,49 +197,28 @@ class Scenario:
         return self.r0_N_m if self.r_target_N_m is None else self.r_target_N_m
 
     def fsw_config(self) -> dict[str, Any]:
-        """The flight-software configuration file content (nominal vehicle + [flight_sw]).
-
-        New keys appear only when the scenario uses the feature, so the configuration of
-        a scenario without them is unchanged: per-thruster ``max_thrust_N`` (when the
-        thrusters' maxima differ from the valve's; the top-level one is their maximum),
-        ``valve_model`` (when throttled; ``min_on_s`` is then 0), and in ``manoeuvre``
-        ``kind`` + ``mrp_coefficients`` (MRP polynomial; ``q_target_BN`` is then the
-        reference at the end of the run) and ``r_target_N_m`` (when given).
-        """
-        maxima = self.max_thrusts_N
-        per_thruster = any(m != self.valve.max_thrust_N for m in maxima)
-        thrusters: list[dict[str, Any]] = []
-        for t, m in zip(self.thrusters, maxima, strict=True):
-            entry: dict[str, Any] = {"r_thr_B_m": list(t.r_thr_B_m), "d_thr_B": list(t.d_thr_B)}
-            if per_thruster:
-                entry["max_thrust_N"] = m
-            thrusters.append(entry)
-        throttled = self.valve.model != "on_off"
-        manoeuvre: dict[str, Any] = {
-            "q_target_BN": list(self.q_target_BN),
-            "t_start_s": self.manoeuvre_start_s,
-        }
-        if self.reference.kind != KIND_STEP:
-            manoeuvre["kind"] = self.reference.kind
-            manoeuvre["mrp_coefficients"] = [list(c) for c in self.reference.mrp_coefficients]
-        if self.r_target_N_m is not None:
-            manoeuvre["r_target_N_m"] = list(self.r_target_N_m)
-        cfg: dict[str, Any] = {
-            "source": override_source(self.path, [
+        """The flight-software configuration file's content (dbc.contract.FswConfig): the
+        nominal vehicle, every thruster with its own maximum thrust, the valves' nominal
+        timing (``min_on_s`` 0 for throttled valves, which have no minimum pulse), the
+        manoeuvre (an MRP polynomial's ``q_target_BN`` is its attitude at the end of the
+        run) and ``[flight_sw]`` as it is."""
+        v = self.valve
+        ref = self.reference
+        config = FswConfig(
+            source=override_source(self.path, [
                 o for o in self.overrides if o.startswith(FSW_TABLE + ".")]),
-            "vehicle": {
-                "mass_kg": self.nominal.mass_kg,
-                "inertia_B_kgm2": [list(r) for r in self.nominal.inertia_B_kgm2],
-            },
-            "thrusters": thrusters,
-            "max_thrust_N": max(maxima),
-            "min_on_s": 0.0 if throttled else self.valve.min_on_s,
-            "manoeuvre": manoeuvre,
-            "flight_sw": self.flight_sw,
-        }
-        if throttled:
-            cfg["valve_model"] = self.valve.model
-        return cfg
+            mass_kg=self.nominal.mass_kg,
+            inertia_B_kgm2=self.nominal.inertia_B_kgm2,
+            thrusters=tuple(ThrusterConfig(t.r_thr_B_m, t.d_thr_B, m)
+                            for t, m in zip(self.thrusters, self.max_thrusts_N, strict=True)),
+            valves=ValveTiming(0.0 if v.model != "on_off" else v.min_on_s, v.open_delay_s,
+                               v.close_delay_s, v.rise_tau_s, v.tail_tau_s),
+            manoeuvre=Manoeuvre(self.q_target_BN, self.manoeuvre_start_s, ref.kind,
+                                ref.mrp_coefficients if ref.kind != KIND_STEP else (),
+                                self.r_target_N_m),
+            flight_sw=self.flight_sw,
+        )
+        return config.to_json()
 
 
 

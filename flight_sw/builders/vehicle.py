@@ -1,9 +1,9 @@
 """The nominal vehicle the flight-software strategies are built from, and shared helpers.
 
-What it does: :class:`Vehicle` reads the configuration file's vehicle data (nominal mass
-[kg] and inertia [kg m²], the thrusters' positions [m] and directions in body axes, the
-maximum thrust of each thruster [N] — one top-level number, or each thruster its own —
-the minimum on-time [s] and the optional ``valve_timing`` table of the valve data),
+What it does: :class:`Vehicle` reads the configuration file's vehicle data
+(dbc.contract.FswConfig: nominal mass [kg] and inertia [kg m²], the thrusters' positions
+[m], directions in body axes and each one's maximum thrust [N], the ``valves`` table: the
+minimum on-time and the valves' delays and time constants [s]),
 builds the effectiveness matrix and records which demand rows the allocator gets (torque,
 or the full wrench in 6 DoF). The helpers read the table forms several builder families
 share (a matrix, an optional rate limit, a dataclass whose every field is optional).
@@ -47,35 +47,31 @@ class Vehicle:
             raise root.error("thrusters", [], "at least one thruster")
         self.r_thr_B_m = np.array([x.vector("r_thr_B_m", 3) for x in thr])
         self.d_thr_B = np.array([x.vector("d_thr_B", 3) for x in thr])
-        # one maximum for all, or each thruster its own (e.g. seed 001's opposing valves of
-        # unequal bounds); every consumer gets the per-thruster vector (n,) [N]
-        default_N = root.number("max_thrust_N", lo=0.0, lo_open=True)
+        # each thruster its own maximum (e.g. seed 001's opposing valves of unequal
+        # bounds); every consumer gets the per-thruster vector (n,) [N]
         self.max_thrust_each_N = np.array(
-            [x.number("max_thrust_N", default_N, lo=0.0, lo_open=True) for x in thr]
-        )
+            [x.number("max_thrust_N", lo=0.0, lo_open=True) for x in thr])
         for x in thr:
             x.done()
-        self.min_on_s = root.number("min_on_s", lo=0.0)
-        self.valve_timing = valve_timing(root)
+        valves = root.table("valves")
+        self.min_on_s = valves.number("min_on_s", lo=0.0)
+        self.valve_timing = valve_timing(valves)
         self.effectiveness = effectiveness_matrix(self.r_thr_B_m, self.d_thr_B)
         self.demand_rows = TORQUE_ROWS  # WRENCH_ROWS once a translation controller is set
         self.control_period_ns = 0
         self.imu_period_ns = 0
 
 
-def valve_timing(root: Table) -> ValveTiming:
-    """The vehicle's valve timing from the optional ``valve_timing`` table (each key
-    optional; defaults: :mod:`flight_sw.fdir.valve_timing`)."""
-    if not root.has("valve_timing"):
-        return DEFAULT_TIMING
-    t = root.table("valve_timing")
-    d = DEFAULT_TIMING
+def valve_timing(t: Table) -> ValveTiming:
+    """The vehicle's valve timing from the configuration's ``valves`` table
+    (dbc.contract.ValveTiming); the command delay is the flight software's own default
+    (:mod:`flight_sw.fdir.valve_timing`)."""
     timing = ValveTiming(
-        command_delay_s=t.number("command_delay_s", d.command_delay_s, lo=0.0),
-        open_delay_s=t.number("open_delay_s", d.open_delay_s, lo=0.0),
-        close_delay_s=t.number("close_delay_s", d.close_delay_s, lo=0.0),
-        rise_tau_s=t.number("rise_tau_s", d.rise_tau_s, lo=0.0),
-        tail_tau_s=t.number("tail_tau_s", d.tail_tau_s, lo=0.0),
+        command_delay_s=DEFAULT_TIMING.command_delay_s,
+        open_delay_s=t.number("open_delay_s", lo=0.0),
+        close_delay_s=t.number("close_delay_s", lo=0.0),
+        rise_tau_s=t.number("rise_tau_s", lo=0.0),
+        tail_tau_s=t.number("tail_tau_s", lo=0.0),
     )
     t.done()
     return timing

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from dbc.contract import FswConfig, Manoeuvre, ThrusterConfig, ValveTiming
 from flight_sw.config import build_computer
 from flight_sw.fdir.base import FailureKind
 from flight_sw.modes import FdirFlag, Mode
@@ -76,20 +77,17 @@ def config() -> dict[str, Any]:
     fsw["thruster_fdir"]["precompute_masks"] = False  # one allocator is built at isolation
     axis = np.ones(3) / math.sqrt(3.0)
     q_target = np.concatenate(([math.cos(SLEW_RAD / 2)], math.sin(SLEW_RAD / 2) * axis))
-    return {
-        "source": "test",
-        "vehicle": {
-            "mass_kg": SEED000_NOMINAL_MASS_KG,
-            "inertia_B_kgm2": np.diag(SEED000_NOMINAL_INERTIA_KGM2).tolist(),
-        },
-        "thrusters": [
-            {"r_thr_B_m": list(a), "d_thr_B": list(b)} for a, b in zip(r, d, strict=True)
-        ],
-        "max_thrust_N": SEED000_THRUST_N,
-        "min_on_s": MIN_ON_NS / NS,
-        "manoeuvre": {"q_target_BN": q_target.tolist(), "t_start_s": T_START_S},
-        "flight_sw": fsw,
-    }
+    return FswConfig(
+        source="test",
+        mass_kg=SEED000_NOMINAL_MASS_KG,
+        inertia_B_kgm2=tuple(tuple(row) for row in np.diag(SEED000_NOMINAL_INERTIA_KGM2)),
+        thrusters=tuple(ThrusterConfig(tuple(a), tuple(b), SEED000_THRUST_N)
+                        for a, b in zip(r, d, strict=True)),
+        valves=ValveTiming(MIN_ON_NS / NS, OPEN_DELAY_NS / NS, CLOSE_DELAY_NS / NS, RISE_TAU_S,
+                           TAIL_TAU_S),
+        manoeuvre=Manoeuvre(tuple(q_target), T_START_S),
+        flight_sw=fsw,
+    ).to_json()
 
 
 class Plant:

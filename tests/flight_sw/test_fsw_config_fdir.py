@@ -119,18 +119,19 @@ def _residual_fdir(cfg: dict[str, Any]) -> RateResidualFdir:
 
 
 def test_vehicle_valve_timing_is_the_residual_fdirs_default(cfg16: dict[str, Any]) -> None:
-    """The file's valve_timing table sets the model's timing unless the FDIR table says."""
+    """The file's valves table (the bench's valve data) sets the model's timing unless the
+    FDIR table says; a negative delay there is refused naming its key."""
     table = cfg16["flight_sw"]["thruster_fdir"]["rate_residual"]
     for key in ("valve_open_delay_s", "valve_tail_tau_s"):
         del table[key]
-    cfg16["valve_timing"] = {"open_delay_s": 0.004, "tail_tau_s": 0.005, "close_delay_s": 0.001}
+    cfg16["valves"].update(open_delay_s=0.004, tail_tau_s=0.005, close_delay_s=0.001)
     timing = _residual_fdir(cfg16).model.timing
     assert (timing.open_delay_s, timing.tail_tau_s) == (0.004, 0.005)  # the vehicle's
     assert timing.close_delay_s == table["valve_close_delay_s"]  # the FDIR table's
-    cfg16["valve_timing"] = {"open_delay_s": -1.0}
+    cfg16["valves"]["open_delay_s"] = -1.0
     with pytest.raises(ConfigError) as info:
         build_computer(cfg16, PERIOD_NS, IMU_NS, WATCH)
-    assert info.value.key == "valve_timing.open_delay_s"
+    assert info.value.key == "valves.open_delay_s"
 
 
 def test_residual_fdir_gets_each_thrusters_maximum(cfg16: dict[str, Any]) -> None:

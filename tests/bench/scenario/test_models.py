@@ -15,6 +15,7 @@ from bench.scenario.parse import parse_scenario
 from bench.station.dynamics.hcw import hcw_closed_form, mean_motion_rad_s
 from bench.station.dynamics.rigid_body import angular_momentum_N
 from bench.station.plant import NS_PER_S, STEP_NS, Plant
+from dbc.contract import CONFIG_SCHEMA, VERSION, FswConfig
 from dbc.errors import ConfigError
 
 if sys.version_info >= (3, 11):
@@ -34,16 +35,19 @@ def _data(path: Path = QUICKSTART) -> dict[str, Any]:
     return tomllib.loads(path.read_text())
 
 
-def test_existing_scenarios_fsw_config_unchanged() -> None:
-    """Without the new keys the flight-software configuration has exactly the historical keys."""
+def test_fsw_config_is_the_contract_record() -> None:
+    """The flight-software configuration is a thruster-hil/fsw-config record: every thruster
+    with its own maximum, the valves' timing, a step manoeuvre; it reads back equal."""
     for path in (QUICKSTART, FDIR16):
         sc = load_scenario(path)
         cfg = sc.fsw_config()
-        assert set(cfg) == {"source", "vehicle", "thrusters", "max_thrust_N", "min_on_s",
+        assert (cfg["schema"], cfg["version"]) == (CONFIG_SCHEMA, VERSION)
+        assert set(cfg) == {"schema", "version", "source", "vehicle", "thrusters", "valves",
                             "manoeuvre", "flight_sw"}
-        assert set(cfg["manoeuvre"]) == {"q_target_BN", "t_start_s"}
-        assert all(set(t) == {"r_thr_B_m", "d_thr_B"} for t in cfg["thrusters"])
-        assert cfg["max_thrust_N"] == sc.valve.max_thrust_N
+        assert set(cfg["manoeuvre"]) == {"kind", "q_target_BN", "t_start_s"}
+        assert [t["max_thrust_N"] for t in cfg["thrusters"]] == list(sc.max_thrusts_N)
+        assert cfg["valves"]["open_delay_s"] == sc.valve.open_delay_s
+        assert FswConfig.from_json(cfg, "test").to_json() == cfg
         assert sc.disturbance is None and not sc.events and sc.dynamics.translation == "inertial"
 
 
@@ -103,7 +107,6 @@ def test_seed001_layout_per_thruster_maxima_reach_fsw_config() -> None:
     sc = parse_scenario(d, "s.toml")
     cfg = sc.fsw_config()
     assert [t["max_thrust_N"] for t in cfg["thrusters"]] == [2.35] * 8 + [2.3] * 8
-    assert cfg["max_thrust_N"] == 2.35
     plant = Plant(sc, 0, IMU_PERIOD_NS)
     assert [v.params.max_thrust_N for v in plant.thrusters.valves] == [2.35] * 8 + [2.3] * 8
 
@@ -119,7 +122,7 @@ def test_explicit_per_thruster_max() -> None:
     ]
     sc = parse_scenario(d, "e.toml")
     assert sc.max_thrusts_N == (3.0, 15.0)
-    assert sc.fsw_config()["max_thrust_N"] == 15.0
+    assert [t["max_thrust_N"] for t in sc.fsw_config()["thrusters"]] == [3.0, 15.0]
 
 
 def test_capture_event_applied_by_the_plant_at_its_step() -> None:
@@ -159,7 +162,8 @@ def test_throttled_plant_and_fsw_config() -> None:
     d = _data()
     d["thrusters"]["valve_model"] = "throttled"
     sc = parse_scenario(d, "t.toml")
-    assert sc.fsw_config()["min_on_s"] == 0.0 and sc.fsw_config()["valve_model"] == "throttled"
+    cfg = sc.fsw_config()
+    assert cfg["valves"]["min_on_s"] == 0.0 and "valve_model" not in cfg  # the bench's own
     plant = Plant(sc, 0, IMU_PERIOD_NS, CONTROL_PERIOD_NS)
     plant.thrusters.command(0, 0, CONTROL_PERIOD_NS // 2)
     plant.advance_to(CONTROL_PERIOD_NS)
