@@ -60,6 +60,8 @@ def main(argv: list[str] | None = None) -> int:
             cycle_time_ns(db, "IMU_RATE"),
             {n: cycle_time_ns(db, n) for n in ("IMU_RATE", "STR_QUAT", "NAV_POS")},
         )
+        for w in computer.warnings:
+            print(f"flight_sw: warning: {w}", file=sys.stderr)
         if args.check:
             print(f"{args.config}: configuration ok")
             return 0

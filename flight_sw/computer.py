@@ -121,6 +121,7 @@ class FlightComputer:
     inertia_id: InertiaIdentifier | None = None
     # realtime: each cycle starts this long after one of the bench's control instants
     cycle_phase_ns: int = DEFAULT_CYCLE_PHASE_NS
+    warnings: tuple[str, ...] = ()  # what this configuration cannot do (authority)
     mode: Mode = Mode.BOOT
     safe_latched: bool = False
     imu_counter: int = 0

@@ -36,6 +36,7 @@ import numpy as np
 from dbc.contract import FswConfig
 from dbc.errors import ConfigError
 from dbc.schema import Table
+from flight_sw.allocation.authority import authority_warnings
 from flight_sw.allocation.base import Allocator
 from flight_sw.builders.allocation import ALLOCATORS
 from flight_sw.builders.control import CONTROLLERS, POSE_CONTROLLERS, TRANSLATION_CONTROLLERS
@@ -234,6 +235,8 @@ def build_computer(
         inertia_id=inertia_id,
         pose=pose,
         cycle_phase_ns=round(phase_s * NS_PER_S),
+        warnings=tuple(authority_warnings(vehicle.effectiveness,
+                                          controls_force=vehicle.demand_rows == WRENCH_ROWS)),
     )
 
 

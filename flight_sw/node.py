@@ -469,6 +469,7 @@ class FlightNode:
                 None if self.fc.inertia_B_kgm2 is None else self.fc.inertia_B_kgm2.tolist()),
             "restarts": st.restarts,
             "restarts_refused": st.restarts_refused,
+            "warnings": list(self.fc.warnings),
             "fdir": self._fdir_stats(),
             # portable bus: frames not delivered to a member that stopped reading
             "bus_overrun_drops": getattr(self.bus, "overrun_drops", 0),

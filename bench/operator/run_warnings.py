@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from bench.operator.authority import WRENCH_CONTROLLERS, authority_warnings
 from bench.operator.plausibility import mass_warnings
 from bench.scenario.spec import Scenario
 
@@ -42,14 +41,12 @@ def overrun_warning(
 
 
 def scenario_warnings(sc: Scenario) -> list[str]:
-    """What the scenario's vehicle cannot do (:mod:`bench.operator.authority`): axes its thrusters
-    cannot push about or along, for the degrees of freedom its flight software controls;
-    and mass properties that look like a unit slip (:mod:`bench.operator.plausibility`)."""
-    controller = (sc.flight_sw.get("controller") or {}).get("kind")
-    needs_force = controller in WRENCH_CONTROLLERS or "translation" in sc.flight_sw
+    """Mass properties of the scenario's vehicle that look like a unit slip
+    (:mod:`bench.operator.plausibility`). What its thrusters cannot push about or along is
+    the flight software's to say (its statistics' ``warnings``): it alone knows which
+    degrees of freedom it controls."""
     r_thr = [t.r_thr_B_m for t in sc.thrusters]
-    out = authority_warnings(r_thr, [t.d_thr_B for t in sc.thrusters], needs_force)
-    out += mass_warnings("[vehicle]", sc.actual.mass_kg, sc.actual.inertia_B_kgm2, r_thr)
+    out = mass_warnings("[vehicle]", sc.actual.mass_kg, sc.actual.inertia_B_kgm2, r_thr)
     if sc.nominal != sc.actual:
         out += mass_warnings("[vehicle.nominal]", sc.nominal.mass_kg,
                              sc.nominal.inertia_B_kgm2, r_thr)

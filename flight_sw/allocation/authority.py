@@ -1,0 +1,50 @@
+"""Control authority of a thruster set: which body directions no non-negative thrust reaches.
+
+What it does: from the effectiveness matrix ``B`` (columns ``[d; r × d]``: force [N] and
+torque [N m] per newton of each thruster, flight_sw.allocation.effectiveness), for each
+signed body axis ±x, ±y, ±z of the torque (and of the force, when this flight software
+controls translation too) whether some thrusts ``T ≥ 0`` produce it: the non-negative
+least-squares residual of ``B T = ±e_i`` (Lawson & Hanson 1974, ch. 23; scipy's ``nnls``)
+is zero to round-off exactly when the axis lies in the cone of the columns. An axis outside
+it is a demand the allocator can never meet: the configuration is accepted (seed 004
+controls a vehicle with three thrusters) but warned about, in the statistics file
+(``warnings``, which the bench shows on its console) and by ``--check``.
+
+Thrusters are on-off valves (thrust ≥ 0); a bidirectional actuator is an opposing pair.
+Pure functions; no units beyond the inputs'.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import nnls
+
+# An axis counts as reached when the NNLS residual is below this (unit target vector).
+REACH_TOL = 1e-9
+AXES = ("x", "y", "z")
+def unreached_axes(rows: np.ndarray) -> list[str]:
+    """The signed axes (``+x`` ... ``-z``) of ``rows`` (3 × n) no thrusts ``T ≥ 0`` give."""
+    out = []
+    for i, axis in enumerate(AXES):
+        for sign in (1.0, -1.0):
+            target = np.zeros(3)
+            target[i] = sign
+            _, residual = nnls(rows, target)
+            if residual > REACH_TOL:
+                out.append(f"{'+' if sign > 0 else '-'}{axis}")
+    return out
+
+
+def authority_warnings(b: np.ndarray, controls_force: bool) -> list[str]:
+    """Warnings for torque (and, if ``controls_force``, force) axes the thrusters of the
+    6 × n effectiveness matrix ``b`` cannot give."""
+    warnings = []
+    for what, rows, needed in (("torque", b[3:6], True), ("force", b[0:3], controls_force)):
+        missing = unreached_axes(rows) if needed else []
+        if missing:
+            warnings.append(
+                f"the {b.shape[1]} thrusters cannot produce {what} about/along "
+                f"{', '.join(missing)} (no non-negative thrust combination does): demands "
+                "there go unmet whatever the controller asks, and show only as an "
+                "allocation residual (fsw.allocation in summary.json)")
+    return warnings

@@ -1,0 +1,43 @@
+"""Control authority: the signed axes a thruster set cannot reach with thrusts T >= 0."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from bench.scenario.load import load_scenario
+from flight_sw.allocation.authority import authority_warnings, unreached_axes
+from flight_sw.allocation.effectiveness import effectiveness_matrix
+
+QUICKSTART = Path(__file__).resolve().parents[3] / "scenarios" / "quickstart.toml"
+
+
+def test_one_thruster_reaches_one_signed_axis() -> None:
+    """r = +y, d = +x: torque r × d = −z only; force +x only."""
+    b = effectiveness_matrix(np.array([(0.0, 1.0, 0.0)]), np.array([(1.0, 0.0, 0.0)]))
+    assert unreached_axes(b[3:]) == ["+x", "-x", "+y", "-y", "+z"]
+    assert unreached_axes(b[:3]) == ["-x", "+y", "-y", "+z", "-z"]
+
+
+def test_seed003_set_has_full_torque_authority_and_losing_yaw_is_warned() -> None:
+    """Quickstart's 8 thrusters reach every torque axis; without those giving z torque, ±z."""
+    sc = load_scenario(QUICKSTART)
+    b = effectiveness_matrix(np.array([t.r_thr_B_m for t in sc.thrusters]),
+                             np.array([t.d_thr_B for t in sc.thrusters]))
+    assert authority_warnings(b, controls_force=False) == []
+    keep = [k for k in range(b.shape[1]) if abs(b[5, k]) < 1e-12]  # no z torque
+    assert keep and len(keep) < b.shape[1]
+    (w,) = authority_warnings(b[:, keep], controls_force=False)
+    assert "cannot produce torque about/along +z, -z" in w
+
+
+def test_a_torque_only_layout_is_warned_only_when_force_is_controlled() -> None:
+    """The quickstart's couples give no net force: a warning only for a 6-DoF flight
+    software, which would need it."""
+    sc = load_scenario(QUICKSTART)
+    b = effectiveness_matrix(np.array([t.r_thr_B_m for t in sc.thrusters]),
+                             np.array([t.d_thr_B for t in sc.thrusters]))
+    assert authority_warnings(b, controls_force=False) == []
+    (w,) = authority_warnings(b, controls_force=True)
+    assert "cannot produce force" in w
