@@ -60,7 +60,8 @@ def fdir_signals(icd: Icd, n_thrusters: int, res: CycleResult | None) -> Signals
                 "SensorFlags": sensor_flags}
     return {
         "AvailableMask": rep.available_mask,
-        "FailedThruster": rep.failed_thruster,
+        "FailedThruster": (icd.no_failed_thruster if rep.failed_thruster is None
+                           else rep.failed_thruster),
         "FailureKind": int(rep.failure_kind),
         "DetectionTime": _clamp(rep.detection_time_s, icd, "FSW_FDIR", "DetectionTime"),
         "IsolationDelay": _clamp(rep.isolation_delay_s, icd, "FSW_FDIR", "IsolationDelay"),

@@ -32,8 +32,6 @@ from enum import IntEnum
 
 import numpy as np
 
-NO_THRUSTER = 31  # FSW_FDIR.FailedThruster value for "none"
-
 
 class FailureKind(IntEnum):
     """FSW_FDIR.FailureKind values (the DBC's VAL_ table)."""

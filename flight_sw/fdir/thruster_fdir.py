@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flight_sw.fdir.base import NO_THRUSTER, FailureKind, ThrusterFailure, ThrusterFdirStrategy
+from flight_sw.fdir.base import FailureKind, ThrusterFailure, ThrusterFdirStrategy
 
 NS_PER_S = 1_000_000_000
 
@@ -39,7 +39,7 @@ class FdirReport:
 
     Attributes:
         available_mask: bit k set = thruster k usable.
-        failed_thruster: latest isolated thruster, ``NO_THRUSTER`` (31) if none.
+        failed_thruster: latest isolated thruster, None if none.
         failure_kind: its kind.
         detection_time_s: when it (or the pending anomaly) was detected [s]; 0 if none.
         isolation_delay_s: isolation minus detection [s]; 0 if none.
@@ -48,7 +48,7 @@ class FdirReport:
     """
 
     available_mask: int
-    failed_thruster: int
+    failed_thruster: int | None
     failure_kind: FailureKind
     detection_time_s: float
     isolation_delay_s: float
@@ -145,7 +145,7 @@ class ThrusterFdir:
             last = self.failures[-1] if self.failures else None
             return FdirReport(
                 mask,
-                last.thruster if last else NO_THRUSTER,
+                last.thruster if last else None,
                 last.kind if last else FailureKind.NONE,
                 self._rel_s(self._pending_ns),
                 0.0,
@@ -153,7 +153,7 @@ class ThrusterFdir:
                 isolated,
             )
         if not self.failures:
-            return FdirReport(mask, NO_THRUSTER, FailureKind.NONE, 0.0, 0.0, False, False)
+            return FdirReport(mask, None, FailureKind.NONE, 0.0, 0.0, False, False)
         f = self.failures[-1]
         return FdirReport(
             mask,

@@ -12,7 +12,6 @@ from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.allocation.pseudo_inverse import PseudoInverseAllocator, PseudoInverseParams
 from flight_sw.computer import FlightComputer, Timeline
 from flight_sw.fdir.base import (
-    NO_THRUSTER,
     FailureKind,
     ThrusterFailure,
     ThrusterFdirStrategy,
@@ -160,7 +159,7 @@ def test_stuck_open_wrench_is_fed_forward(
             assert res.fdir.available_mask == (1 << N) - 1 - (1 << failed)
         else:
             assert b @ thrust == pytest.approx(wrench, abs=1e-9)
-            assert res.fdir is not None and res.fdir.failed_thruster == NO_THRUSTER
+            assert res.fdir is not None and res.fdir.failed_thruster is None
         assert res.mode == Mode.NOMINAL
 
 
