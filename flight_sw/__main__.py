@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import gc
-import json
 import os
 import sys
 from pathlib import Path
@@ -22,6 +21,7 @@ from dbc.codec import cycle_time_ns
 from dbc.contract import EXIT_REFUSED, FswRefusal
 from dbc.database import load_database
 from dbc.errors import BusError, ConfigError
+from dbc.records import write_record
 from flight_sw.config import build_computer, load_config
 from flight_sw.node import FlightNode
 from flight_sw.rx_log import ReceiveLog
@@ -33,7 +33,7 @@ def _write_refusal(stats: str | None, refusal: FswRefusal) -> None:
     """The refusal record (dbc.contract) as the statistics file: the bench reports it."""
     if stats:
         with contextlib.suppress(OSError):  # the message is on stderr as well
-            Path(stats).write_text(json.dumps(refusal.to_json()) + "\n", encoding="utf-8")
+            write_record(Path(stats), refusal.to_json())
 
 
 def main(argv: list[str] | None = None) -> int:

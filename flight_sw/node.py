@@ -43,6 +43,7 @@ from dbc.codec import Decoded, Encoder, FrameChecker, Reject
 from dbc.contract import STATS_SCHEMA, VERSION
 from dbc.icd import BENCH, FSW, Icd
 from dbc.quaternion import pack_quaternion, unpack_quaternion
+from dbc.records import write_record
 from flight_sw.clock import MonotonicClock
 from flight_sw.computer import CycleResult, FlightComputer
 from flight_sw.frames import command_signals, fdir_signals, status_signals
@@ -52,7 +53,6 @@ from flight_sw.stats import (
     percentiles_us,
     second_sender_evidence,
     spread,
-    write_json_atomic,
 )
 from transport.lockstep import recv_spinning, send_frames
 
@@ -476,4 +476,4 @@ class FlightNode:
             "bus_overrun_drops_by_pid": {
                 str(k): v for k, v in getattr(self.bus, "overrun_drops_by_pid", {}).items()},
         }
-        write_json_atomic(self.stats_path, data)
+        write_record(self.stats_path, data)

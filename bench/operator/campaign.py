@@ -30,6 +30,7 @@ from typing import Any
 from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError, RunError
 from dbc.faults import STUCK_CLOSED, STUCK_OPEN
+from dbc.records import write_record
 from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
 KINDS = (STUCK_CLOSED, STUCK_OPEN)
@@ -115,7 +116,7 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
         w = csv.DictWriter(f, fieldnames=COLUMNS)
         w.writeheader()
         w.writerows(rows)
-    (out / "campaign.json").write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+    write_record(out / "campaign.json", {"cases": rows})
     _plot(rows, out / "campaign.png")
     return rows
 

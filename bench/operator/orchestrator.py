@@ -50,6 +50,7 @@ from dbc.codec import cycle_time_ns
 from dbc.contract import EXIT_REFUSED
 from dbc.database import load_database
 from dbc.errors import ConfigError, RefusedConfigError, RunError
+from dbc.records import write_record
 from transport.hilbus import MEMBER_STALL_S
 from transport.lockstep import available_cpus, lockstep_spin_s
 from transport.spec import mode_options, open_bus
@@ -108,7 +109,7 @@ def run_scenario(
         out.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(sc.path, out / "scenario.toml")
         config = out / "fsw_config.json"
-        config.write_text(json.dumps(sc.fsw_config(), indent=2) + "\n", encoding="utf-8")
+        write_record(config, sc.fsw_config())
     except OSError as exc:
         raise ConfigError("command line", "--out", str(out),
                           f"a folder this user can create and write ({exc.strerror or exc})"

@@ -14,7 +14,10 @@ from typing import Any
 
 import numpy as np
 
-PERCENTILES = (50.0, 99.0)
+from dbc.records import percentile_summary
+
+NS_PER_US = 1e3
+LATENCY_DIGITS = 3  # 1 ns in microseconds
 
 
 @dataclass(frozen=True)
@@ -80,17 +83,8 @@ def settling_time_s(
 
 
 def latency_summary(samples_ns: list[int]) -> dict[str, Any]:
-    """p50, p99, max in microseconds and the sample count."""
-    if not samples_ns:
-        return {"p50": None, "p99": None, "max": None, "n": 0}
-    a = np.asarray(samples_ns, dtype=float) / 1e3
-    p50, p99 = np.percentile(a, PERCENTILES)
-    return {
-        "p50": round(float(p50), 3),
-        "p99": round(float(p99), 3),
-        "max": round(float(a.max()), 3),
-        "n": len(samples_ns),
-    }
+    """p50, p99, max in microseconds (1 ns resolution) and the sample count."""
+    return percentile_summary(samples_ns, NS_PER_US, LATENCY_DIGITS)
 
 
 def expectation(

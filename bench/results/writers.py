@@ -14,10 +14,10 @@ No clock is read here.
 from __future__ import annotations
 
 import csv
-import json
-import math
 from pathlib import Path
 from typing import IO, Any
+
+from dbc.records import write_record
 
 NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at 1e4 s
 # per control cycle: IMU sample sent, last command frame received, first command frame that
@@ -65,19 +65,6 @@ class TelemetryWriter:
         self._file.close()
 
 
-def _clean(x: Any) -> Any:
-    """JSON-safe: NaN and infinities become null."""
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_clean(v) for v in x]
-    return x
-
-
 def write_summary(path: Path, summary: dict[str, Any]) -> None:
     """Write ``summary`` as strict JSON (NaN and infinities as null), atomically."""
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(_clean(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    tmp.replace(path)
+    write_record(path, summary)

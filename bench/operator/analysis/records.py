@@ -32,11 +32,11 @@ from bench.operator.analysis.defaults import (
     DEFAULT_WINDOW_MS,
 )
 from dbc.errors import ConfigError
+from dbc.records import percentile_summary
 
 US_PER_S = 1e6
 MS_PER_S = 1e3
 PCT = 100.0
-PERCENTILE_LEVELS = (50.0, 99.0)
 NAN = float("nan")
 OPTIONS_SOURCE = "TimingOptions"
 
@@ -98,10 +98,11 @@ class Percentiles:
         """Percentiles (linear interpolation) of the finite samples, given in seconds."""
         a = np.asarray(samples_s, dtype=float)
         a = a[np.isfinite(a)] * US_PER_S
-        if a.size == 0:
+        s = percentile_summary(a.tolist())
+        if not s["n"]:
             return cls(NAN, NAN, NAN, 0)
-        p50, p99 = np.percentile(a, PERCENTILE_LEVELS)
-        return cls(float(p50), float(p99), float(a.max()), int(a.size))
+        return cls(float(s["p50"] or NAN), float(s["p99"] or NAN), float(s["max"] or NAN),
+                   int(s["n"] or 0))
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (nan -> None)."""

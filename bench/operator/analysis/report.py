@@ -10,7 +10,6 @@ backend; no display needed. Times in the table: periods in ms, everything else i
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import numpy as np
 
 from bench.operator.analysis.records import US_PER_S, LoadFigures, MessageTiming, Percentiles
 from bench.operator.analysis.timing import RunTiming
+from dbc.records import write_record
 
 TIMING_JSON = "timing.json"
 LATENCY_PNG = "latency_hist.png"
@@ -151,7 +151,7 @@ def format_report(rt: RunTiming) -> str:
 def write_json(rt: RunTiming, out_dir: Path) -> Path:
     """``timing.json`` with :meth:`RunTiming.to_dict` in ``out_dir``; returns its path."""
     path = out_dir / TIMING_JSON
-    path.write_text(json.dumps(rt.to_dict(), indent=2) + "\n", encoding="utf-8")
+    write_record(path, rt.to_dict())
     return path
 
 
