@@ -1,6 +1,11 @@
-"""The flight software's frames out: a cycle's result -> FSW_STATUS, FSW_FDIR, THR_CMD_n signals.
+"""The flight software's frames: sensor frames in -> the computer; a cycle's result -> frames out.
 
-In: a :class:`~flight_sw.computer.CycleResult` (on-times [s] per thruster, mode, flags,
+In (:func:`feed`): a checked sensor frame of the bench (IMU_RATE [rad/s], IMU_ACCEL
+[m/s²], STR_QUAT, NAV_POS [m], NAV_VEL [m/s], THR_STATUS), fed to the flight computer at
+its time of receipt; invalid samples (``Valid`` = 0) are not fed.
+
+Out:
+a :class:`~flight_sw.computer.CycleResult` (on-times [s] per thruster, mode, flags,
 allocation residuals [N m], [N], the FDIR report), the cycle number, the counters the
 node keeps, and the ICD's facts (dbc.icd: command frames and their on-time signals, the
 cycle counters' widths, signal ranges, the "no thruster" value). Out: physical signal
@@ -18,8 +23,12 @@ later than the previous one. Pure functions.
 
 from __future__ import annotations
 
+import numpy as np
+
+from dbc.codec import Decoded
 from dbc.icd import Icd
-from flight_sw.computer import CycleResult
+from dbc.quaternion import unpack_quaternion
+from flight_sw.computer import CycleResult, FlightComputer
 
 # A full-period pulse is sent this much longer, to bridge command-arrival jitter; far
 # below the DBC's on-time range and the bench's valve watchdog.
@@ -85,3 +94,30 @@ def command_signals(icd: Icd, cycle: int, res: CycleResult, n_thrusters: int,
             sig[icd.on_time_signals[k]] = round(on / lsb) * lsb
         out.append((name, sig))
     return out
+
+
+def feed(fc: FlightComputer, d: Decoded, t_ns: int) -> bool:
+    """Feed sensor frame ``d`` to ``fc`` at ``t_ns``; True when it is a sample the sensor
+    watchdog counts (a valid IMU_RATE or star-tracker sample the computer took)."""
+    s = d.signals
+    name = d.name
+    if name == "IMU_RATE":
+        return bool(s["Valid"]) and fc.on_imu_rate(
+            t_ns, np.array((s["RateX"], s["RateY"], s["RateZ"])), d.counter, d.gap)
+    if name == "IMU_ACCEL":
+        if s["Valid"]:
+            fc.on_imu_accel(t_ns, np.array((s["AccelX"], s["AccelY"], s["AccelZ"])),
+                            d.counter, d.gap)
+    elif name == "STR_QUAT":
+        payload = (s["Largest"], s["C0"], s["C1"], s["C2"])
+        return bool(s["Valid"]) and fc.on_star_tracker(
+            t_ns, np.array(unpack_quaternion(s)), payload)
+    elif name == "NAV_POS":
+        if s["Valid"]:
+            fc.on_nav_pos(t_ns, np.array((s["PosX"], s["PosY"], s["PosZ"])))
+    elif name == "NAV_VEL":
+        if s["Valid"]:
+            fc.on_nav_vel(t_ns, np.array((s["VelX"], s["VelY"], s["VelZ"])))
+    elif name == "THR_STATUS":
+        fc.on_thr_status(t_ns, s)
+    return False

@@ -7,16 +7,11 @@ DLC, CRC, alive counter, range; our own messages heard from another node are cou
 FSW_ATT_EST, FSW_FDIR, THR_CMD_0..m. IDs, periods and counter widths come from the DBC
 (dbc.icd).
 
-Freshness, taken before a frame counts (a rejected frame moves no alive counter): a SYNC
-whose cycle is not newer than the last one taken is ``stale``, as is a BENCH_STATUS whose
-time goes backwards, unless the bench restarted. Bench restart: a SYNC whose cycle goes
-back to 0 (or more than ``STALE_SYNC_WINDOW`` cycles back), or a BENCH_STATUS whose time
-goes backwards, after the bench has been quiet (no frame of it taken) for at least
-``RESTART_QUIET_NS`` of wall-clock time: a restarted bench is silent far longer (it waits
-for our heartbeat). Then the flight computer is re-initialised on the bench's new time
-(:meth:`FlightComputer.restart`), the cycle bookkeeping starts again and the new SYNC is
-answered. Without the quiet period such a frame is a replay or a forgery: rejected as
-stale and counted in ``restarts_refused``, never a restart.
+Freshness and bench restarts (flight_sw.bench_link; docs/icd.md "Restarts"): a stale SYNC
+or BENCH_STATUS is rejected without moving any alive counter; a bench restart (SYNC back
+to 0, BENCH_STATUS time going back) is taken only after the bench has been quiet, then
+the flight computer is re-initialised on the bench's new time and the new SYNC answered;
+otherwise the frame is a replay, counted in ``restarts_refused``.
 In realtime the flight computer's manoeuvre time is aligned on the first BENCH_STATUS.
 Heartbeat: FSW_STATUS alone at start-up and after every second without any received frame
 (before the first SYNC), and after ``LOCKSTEP_SILENCE_HEARTBEAT_S`` once cycling.
@@ -33,27 +28,20 @@ from __future__ import annotations
 import signal
 from pathlib import Path
 from types import FrameType
-from typing import Any
 
 import can
-import numpy as np
 from cantools.database.can import Database
 
-from dbc.codec import Decoded, Encoder, FrameChecker, Reject
-from dbc.contract import STATS_SCHEMA, VERSION
+from dbc.codec import Decoded, Encoder, FrameChecker
 from dbc.icd import BENCH, FSW, Icd
-from dbc.quaternion import pack_quaternion, unpack_quaternion
+from dbc.quaternion import pack_quaternion
 from dbc.records import write_record
+from flight_sw.bench_link import BenchLink, Verdict, sim_time_ns
 from flight_sw.clock import MonotonicClock
 from flight_sw.computer import CycleResult, FlightComputer
-from flight_sw.frames import command_signals, fdir_signals, status_signals
+from flight_sw.frames import command_signals, fdir_signals, feed, status_signals
 from flight_sw.rx_log import ReceiveLog
-from flight_sw.stats import (
-    NodeStats,
-    percentiles_us,
-    second_sender_evidence,
-    spread,
-)
+from flight_sw.stats import NodeStats, stats_record
 from transport.lockstep import recv_spinning, send_frames
 
 HEARTBEAT_RETRY_S = 1.0  # silence before the next FSW_STATUS heartbeat, until the first SYNC
@@ -63,11 +51,6 @@ HEARTBEAT_RETRY_S = 1.0  # silence before the next FSW_STATUS heartbeat, until t
 # deterministic trace and shift FSW_STATUS's alive counter. A restarted bench waits for the
 # heartbeat up to its startup timeout (60 s by default), so a longer silence is harmless.
 LOCKSTEP_SILENCE_HEARTBEAT_S = 5.0
-# A SYNC at most this many cycles behind the last one is stale; further back, a restart.
-STALE_SYNC_WINDOW = 2
-RESTART_QUIET_NS = 200_000_000  # bench silence [ns, wall clock] before a restart is taken
-MS_PER_S = 1000
-NS_PER_MS = 1_000_000
 NS_PER_S = 1e9
 STATS_EVERY_STATUS_PERIODS = 10  # realtime: the statistics file is rewritten this often
 
@@ -76,11 +59,6 @@ def _next_phase_ns(now_ns: int, base_ns: int, period_ns: int, phase_ns: int) -> 
     """The first ``base + k·period + phase`` (k integer) after ``now_ns``."""
     k = (now_ns - base_ns - phase_ns) // period_ns + 1
     return base_ns + k * period_ns + phase_ns
-
-
-def _ms_to_ns(t_s: float) -> int:
-    """A SimTime signal [s] (1 ms LSB) on the flight software's ns time axis."""
-    return round(float(t_s) * MS_PER_S) * NS_PER_MS
 
 
 class StopRequested(Exception):  # noqa: N818 - a request, not an error
@@ -111,14 +89,10 @@ class FlightNode:
         self._waiting = False  # blocked in the bus receive: a stop signal may interrupt
         self.lockstep_silence_heartbeat_s = LOCKSTEP_SILENCE_HEARTBEAT_S
         self.lockstep_spin_s = 0.0  # lockstep: poll this long before blocking (transport.lockstep)
-        self.restart_quiet_ns = RESTART_QUIET_NS
-        self._last_sync: int | None = None
+        self.link = BenchLink(self.checker)  # which SYNC / BENCH_STATUS count, restarts
         self._pending_seen: set[str] = set()
-        self._sync_cycle = -1
         self._last_result: CycleResult | None = None
         self._reported: tuple[int, int, int] | None = None  # (mode, FDIR, sensor flags) sent
-        self._bench_time_ns: int | None = None  # newest BENCH_STATUS SimTime
-        self._bench_heard_ns: int | None = None  # our clock when a bench frame was last taken
         self._realtime = False
         self._time_aligned = False
         # lockstep: the frames of the cycle being computed, sent together at its end
@@ -232,64 +206,17 @@ class FlightNode:
     # -- receive -----------------------------------------------------------------
     def handle(self, d: Decoded, t_ns: int) -> None:
         """Feed one checked sensor frame to the computer, stamped ``t_ns``."""
-        s = d.signals
-        fc = self.fc
-        name = d.name
-        if name == "IMU_RATE":
-            if s["Valid"] and fc.on_imu_rate(
-                t_ns, np.array((s["RateX"], s["RateY"], s["RateZ"])), d.counter, d.gap
-            ):
-                self._pending_seen.add(name)
-        elif name == "IMU_ACCEL":
-            if s["Valid"]:
-                fc.on_imu_accel(
-                    t_ns, np.array((s["AccelX"], s["AccelY"], s["AccelZ"])), d.counter, d.gap
-                )
-        elif name == "STR_QUAT":
-            payload = (s["Largest"], s["C0"], s["C1"], s["C2"])
-            if s["Valid"] and fc.on_star_tracker(t_ns, np.array(unpack_quaternion(s)), payload):
-                self._pending_seen.add(name)
-        elif name == "NAV_POS":
-            if s["Valid"]:
-                fc.on_nav_pos(t_ns, np.array((s["PosX"], s["PosY"], s["PosZ"])))
-        elif name == "NAV_VEL":
-            if s["Valid"]:
-                fc.on_nav_vel(t_ns, np.array((s["VelX"], s["VelY"], s["VelZ"])))
-        elif name == "THR_STATUS":
-            fc.on_thr_status(t_ns, s)
-
-    def _bench_quiet(self, now_ns: int) -> bool:
-        """The bench has been silent long enough for a restart to be genuine."""
-        heard = self._bench_heard_ns
-        return heard is None or now_ns - heard >= self.restart_quiet_ns
-
-    def _take(self, d: Decoded, now_ns: int) -> None:
-        """The frame passed every check and its freshness: it counts."""
-        self.checker.accept(d)
-        self._bench_heard_ns = now_ns
-
-    def _refuse_restart(self, d: Decoded) -> None:
-        """A frame that would restart us while the bench is live: stale, counted."""
-        self.checker.reject(d.name, Reject.STALE)
-        self.stats.restarts_refused += 1
+        if feed(self.fc, d, t_ns):
+            self._pending_seen.add(d.name)
 
     def _on_bench_status(self, d: Decoded, now_ns: int) -> None:
-        """BENCH_STATUS SimTime: a step back is a bench restart (after a quiet bench) or
-        stale; realtime aligns the timeline on it (the first one, then any that shows the
-        bench's time 0 earlier)."""
-        bench_ns = _ms_to_ns(d.signals["SimTime"])
-        last = self._bench_time_ns
-        if last is not None and bench_ns < last:
-            if not self._bench_quiet(now_ns):
-                self._refuse_restart(d)
-                return
-            self._take(d, now_ns)
+        """BENCH_STATUS (flight_sw.bench_link): a restart, or the bench's time; realtime aligns
+        the timeline on it (the first one, then any that shows the bench's time 0 earlier)."""
+        verdict = self.link.bench_status(d, now_ns)
+        bench_ns = self.link.bench_time_ns or 0
+        if verdict is Verdict.RESTART:
             self.bench_restarted(self.clock.now_ns() if self._realtime else bench_ns, bench_ns)
-            self._bench_time_ns = bench_ns
-            return
-        self._take(d, now_ns)
-        self._bench_time_ns = bench_ns
-        if self._realtime:
+        elif verdict is Verdict.TAKEN and self._realtime:
             # our time of the bench's time 0: the earliest estimate so far (each arrives
             # late by its transport and our own reading delay, never early; same clock)
             base = self.clock.now_ns() - bench_ns
@@ -299,13 +226,12 @@ class FlightNode:
                     self.fc.thruster_fdir.time_base_ns = base
             self._time_aligned = True
 
-    def bench_restarted(self, t_ns: int, bench_ns: int) -> None:
-        """Start again with a restarted bench: our time ``t_ns`` is its time ``bench_ns``."""
-        self.fc.restart(t_ns, bench_ns)
+    def bench_restarted(self, t_ns: int, bench_ns: int | None) -> None:
+        """Start again with a restarted bench: our time ``t_ns`` is its time ``bench_ns``
+        (None: not known yet, a SYNC restart)."""
+        self.fc.restart(t_ns, t_ns if bench_ns is None else bench_ns)
         self.stats.restarts += 1
-        self._last_sync = None
-        self._sync_cycle = -1
-        self._bench_time_ns = None
+        self.link.restarted(bench_ns)
         self._pending_seen.clear()
         self._time_aligned = self._realtime
 
@@ -314,29 +240,13 @@ class FlightNode:
         self._send("FSW_STATUS", self._status(self.stats.cycles))
 
     # -- loops -------------------------------------------------------------------
-    def _sync(self, d: Decoded, now_ns: int) -> tuple[int, int] | None:
-        """A checked SYNC: (cycle, time) to run, or None when it is stale (counted)."""
-        cycle = int(d.signals["Cycle"])
-        t_ns = _ms_to_ns(d.signals["SimTime"])
-        if self._last_sync is not None and cycle <= self._sync_cycle:
-            if cycle != 0 and self._sync_cycle - cycle <= STALE_SYNC_WINDOW:
-                self.checker.reject("SYNC", Reject.STALE)
-                return None
-            if not self._bench_quiet(now_ns):
-                self._refuse_restart(d)
-                return None
-            self._take(d, now_ns)
-            self.bench_restarted(t_ns, t_ns)
-            return cycle, t_ns
-        self._take(d, now_ns)
-        return cycle, t_ns
-
     def run_lockstep(self) -> None:
         """Cycle on SYNC frames until stopped."""
         self._heartbeat()
         clock = self.clock
+        link = self.link
         while not self._stop:
-            silence_s = (HEARTBEAT_RETRY_S if self._last_sync is None
+            silence_s = (HEARTBEAT_RETRY_S if link.last_sync_ns is None
                          else self.lockstep_silence_heartbeat_s)
             msg = self._recv(silence_s)
             if msg is None:
@@ -350,19 +260,22 @@ class FlightNode:
                 self._on_bench_status(d, now)
                 continue
             if d.name != "SYNC":
-                self._take(d, now)
-                self.handle(d, self._last_sync or 0)
+                link.take(d, now)
+                self.handle(d, link.last_sync_ns or 0)
                 continue
-            run = self._sync(d, now)
-            if run is None:
+            verdict = link.sync(d, now)
+            if verdict is Verdict.STALE:
                 continue
-            cycle, t_ns = run
-            if self._last_sync is None:
+            if verdict is Verdict.RESTART:
+                t_restart = sim_time_ns(d.signals["SimTime"])
+                self.bench_restarted(t_restart, None)
+            first = link.last_sync_ns is None
+            cycle, t_ns = link.ran(d)
+            if first:
                 self.fc.watchdog.start(t_ns)
             for name in self._pending_seen:
                 self.fc.watchdog.seen(name, t_ns)
             self._pending_seen.clear()
-            self._last_sync, self._sync_cycle = t_ns, cycle
             self.run_cycle(cycle, t_ns)
         self.write_stats()
 
@@ -419,61 +332,16 @@ class FlightNode:
         if d.name == "BENCH_STATUS":
             self._on_bench_status(d, t)
             return
-        self._take(d, t)
+        self.link.take(d, t)
         self.handle(d, t)
         for name in self._pending_seen:
             self.fc.watchdog.seen(name, t)
         self._pending_seen.clear()
 
     # -- statistics --------------------------------------------------------------
-    def _fdir_stats(self) -> dict[str, Any]:
-        """Isolated thruster failures (times relative to the bench's time 0) and flags."""
-        res = self._last_result
-        out: dict[str, Any] = {
-            "sensor_flags": res.sensor_flags if res is not None else 0,
-            "fdir_flags": res.fdir_flags if res is not None else 0,
-            "failures": [],
-        }
-        fdir = self.fc.thruster_fdir
-        if fdir is not None:
-            base = fdir.time_base_ns
-            out["available_mask"] = int(sum(1 << k for k in range(fdir.n) if fdir.mask[k]))
-            out["failures"] = [
-                {"thruster": f.thruster, "kind": f.kind.name.lower(),
-                 "t_detect_s": (f.t_detect_ns - base) / NS_PER_S,
-                 "t_isolate_s": (f.t_isolate_ns - base) / NS_PER_S, "source": f.source}
-                for f in fdir.failures
-            ]
-        return out
-
     def write_stats(self) -> None:
-        """Write the node's statistics JSON (atomically) if a path was given."""
-        if self.stats_path is None:
-            return
-        st = self.stats
-        received = self.checker.summary()
-        data: dict[str, Any] = {
-            "schema": STATS_SCHEMA,
-            "version": VERSION,
-            "cycles": st.cycles,
-            "overruns": st.overruns,
-            "sent": dict(sorted(st.sent.items())),
-            "received": received,
-            "second_sender_evidence": second_sender_evidence(received),
-            "mode": self.fc.mode.name,
-            "cycle_time_us": percentiles_us(st.cycle_ns),
-            "allocation": {"residual_torque_Nm": spread(st.residual_Nm),
-                           "residual_force_N": spread(st.residual_N),
-                           "saturated_cycles": st.saturated_cycles, "cycles": st.cycles},
-            "inertia_estimate_B_kgm2": (
-                None if self.fc.inertia_B_kgm2 is None else self.fc.inertia_B_kgm2.tolist()),
-            "restarts": st.restarts,
-            "restarts_refused": st.restarts_refused,
-            "warnings": list(self.fc.warnings),
-            "fdir": self._fdir_stats(),
-            # portable bus: frames not delivered to a member that stopped reading
-            "bus_overrun_drops": getattr(self.bus, "overrun_drops", 0),
-            "bus_overrun_drops_by_pid": {
-                str(k): v for k, v in getattr(self.bus, "overrun_drops_by_pid", {}).items()},
-        }
-        write_record(self.stats_path, data)
+        """Write the node's statistics record (flight_sw.stats) if a path was given."""
+        if self.stats_path is not None:
+            write_record(self.stats_path, stats_record(
+                self.stats, self.checker.summary(), self.fc, self._last_result, self.bus,
+                self.link.restarts_refused))

@@ -14,9 +14,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from dbc.contract import STATS_SCHEMA, VERSION
 from dbc.records import percentile_summary
+from flight_sw.computer import CycleResult, FlightComputer
 
 NS_PER_US = 1e3
+NS_PER_S = 1e9
 CYCLE_TIME_DIGITS = 1  # 0.1 us
 EVIDENCE = ("unexpected", "sequence")  # receive causes that show a second sender
 
@@ -28,7 +31,6 @@ class NodeStats:
     cycles: int = 0
     overruns: int = 0
     restarts: int = 0
-    restarts_refused: int = 0
     sent: dict[str, int] = field(default_factory=dict)
     cycle_ns: list[int] = field(default_factory=list)  # cycle start -> last frame sent
     residual_Nm: list[float] = field(default_factory=list)  # allocation torque residual
@@ -55,3 +57,53 @@ def second_sender_evidence(received: dict[str, dict[str, Any]]) -> dict[str, int
         if n:
             out[name] = n
     return out
+
+
+def _fdir(fc: FlightComputer, res: CycleResult | None) -> dict[str, Any]:
+    """Isolated thruster failures (times relative to the bench's time 0) and flags."""
+    out: dict[str, Any] = {
+        "sensor_flags": res.sensor_flags if res is not None else 0,
+        "fdir_flags": res.fdir_flags if res is not None else 0,
+        "failures": [],
+    }
+    fdir = fc.thruster_fdir
+    if fdir is not None:
+        base = fdir.time_base_ns
+        out["available_mask"] = int(sum(1 << k for k in range(fdir.n) if fdir.mask[k]))
+        out["failures"] = [
+            {"thruster": f.thruster, "kind": f.kind.name.lower(),
+             "t_detect_s": (f.t_detect_ns - base) / NS_PER_S,
+             "t_isolate_s": (f.t_isolate_ns - base) / NS_PER_S, "source": f.source}
+            for f in fdir.failures
+        ]
+    return out
+
+
+def stats_record(st: NodeStats, received: dict[str, dict[str, Any]], fc: FlightComputer,
+                 res: CycleResult | None, bus: Any, restarts_refused: int) -> dict[str, Any]:
+    """The statistics record (``thruster-hil/fsw-stats``, docs/icd.md): the node's
+    counters, its receive statistics, the computer's final state and, on the portable
+    bus, the frames not delivered to a member that stopped reading."""
+    return {
+        "schema": STATS_SCHEMA,
+        "version": VERSION,
+        "cycles": st.cycles,
+        "overruns": st.overruns,
+        "sent": dict(sorted(st.sent.items())),
+        "received": received,
+        "second_sender_evidence": second_sender_evidence(received),
+        "mode": fc.mode.name,
+        "cycle_time_us": percentiles_us(st.cycle_ns),
+        "allocation": {"residual_torque_Nm": spread(st.residual_Nm),
+                       "residual_force_N": spread(st.residual_N),
+                       "saturated_cycles": st.saturated_cycles, "cycles": st.cycles},
+        "inertia_estimate_B_kgm2": (
+            None if fc.inertia_B_kgm2 is None else fc.inertia_B_kgm2.tolist()),
+        "restarts": st.restarts,
+        "restarts_refused": restarts_refused,
+        "warnings": list(fc.warnings),
+        "fdir": _fdir(fc, res),
+        "bus_overrun_drops": getattr(bus, "overrun_drops", 0),
+        "bus_overrun_drops_by_pid": {
+            str(k): v for k, v in getattr(bus, "overrun_drops_by_pid", {}).items()},
+    }

@@ -22,10 +22,11 @@ from bench.scenario.load import load_scenario
 from dbc.codec import Encoder, FrameChecker, cycle_time_ns
 from dbc.database import load_database
 from dbc.quaternion import pack_quaternion
+from flight_sw.bench_link import RESTART_QUIET_NS
 from flight_sw.config import build_computer
 from flight_sw.frames import FULL_ON_OVERLAP_S
 from flight_sw.modes import FdirFlag, Mode, SensorFlag
-from flight_sw.node import HEARTBEAT_RETRY_S, RESTART_QUIET_NS, FlightNode
+from flight_sw.node import HEARTBEAT_RETRY_S, FlightNode
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 RECV_TIMEOUT_S = 5.0
@@ -215,7 +216,7 @@ def test_sync_back_to_zero_is_a_bench_restart(setup: tuple[FlightNode, Bench]) -
     """SYNC(0) after SYNC(6) from a bench that was quiet (here: no quiet period asked):
     answered, the computer starts again, SensorFlags bit 3 set."""
     node, bench = setup
-    node.restart_quiet_ns = 0
+    node.link.restart_quiet_ns = 0
     for k in range(7):
         bench.sensors()
         bench.sync(k)
@@ -238,7 +239,7 @@ def test_bench_time_going_backwards_is_a_restart(setup: tuple[FlightNode, Bench]
     """BENCH_STATUS SimTime 0.1 s then 0.0 s from a quiet bench: restart; the next SYNC(0)
     is answered."""
     node, bench = setup
-    node.restart_quiet_ns = 0
+    node.link.restart_quiet_ns = 0
     for k in range(6):
         bench.sensors()
         if k == 5:
@@ -271,7 +272,7 @@ def test_replayed_sync_zero_from_a_live_bench_is_stale_not_a_restart(
     """The first SYNC(0), replayed while the bench answers every cycle: rejected as stale
     (a refused restart), never a restart; the next genuine SYNC is answered as usual."""
     node, bench = setup
-    assert node.restart_quiet_ns == RESTART_QUIET_NS
+    assert node.link.restart_quiet_ns == RESTART_QUIET_NS
     for k in range(4):
         bench.sensors()
         bench.sync(k)
@@ -280,7 +281,7 @@ def test_replayed_sync_zero_from_a_live_bench_is_stale_not_a_restart(
     got = bench.sync(4)
     assert got["THR_CMD_0"]["Cycle"] == 4
     assert node.fc.restarts == 0 and node.stats.restarts == 0
-    assert node.stats.restarts_refused == 1
+    assert node.link.restarts_refused == 1
     assert node.checker.summary()["SYNC"]["rejected"] == {"stale": 1}
 
 
