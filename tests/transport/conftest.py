@@ -23,8 +23,3 @@ def pair(channel: str) -> Iterator[tuple[HilBus, HilBus]]:
     with HilBus(channel) as a, HilBus(channel) as b:
         yield a, b
 
-
-def pytest_configure(config: pytest.Config) -> None:
-    """Register pytest-timeout's marker, which python-can's back-to-back suite uses
-    (tests/transport/test_python_can_back2back.py); without that plugin it limits nothing."""
-    config.addinivalue_line("markers", "timeout(seconds): per-test time limit (pytest-timeout)")
