@@ -1,13 +1,14 @@
-"""Validators of the flight software's frozen parameter dataclasses ("finite real number" etc.).
+"""Validators of the project's frozen parameter dataclasses ("finite real number" etc.).
 
-What it does: one small set of checks that every parameter dataclass of the flight
-software calls from its ``__post_init__`` (and the strategies from their constructors),
-so that a bad value is refused the same way everywhere: with
-:class:`dbc.errors.ConfigError` ``(source, key, value, expected)``, where ``source`` names
-the dataclass (e.g. ``"PwpfParams"``), ``key`` the field, ``value`` the value given and
-``expected`` what would have been accepted, in words (``"a finite number > 0 [s]"``).
-The configuration loader (:mod:`flight_sw.config`) re-anchors such an error in the
-scenario file and its dotted key.
+What it does: one small set of checks, in the contract package so that both sides (the
+flight software and the bench, which never import each other) use the same ones: every
+parameter dataclass of the flight software calls them from its ``__post_init__`` (and the
+strategies from their constructors), so that a bad value is refused the same way
+everywhere: with :class:`dbc.errors.ConfigError` ``(source, key, value, expected)``, where
+``source`` names the dataclass (e.g. ``"PwpfParams"``), ``key`` the field, ``value`` the
+value given and ``expected`` what would have been accepted, in words (``"a finite number
+> 0 [s]"``). The configuration loader (:mod:`flight_sw.config`) re-anchors such an error
+in the scenario file and its dotted key.
 
 Inputs: the value as given (any object). Outputs: the value converted to the type the
 dataclass stores (``float``, ``int``, ``bool``, a tuple of floats, a float64 array).

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
+from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw import validation as check
 
 SOURCE = "SomeParams"
 
