@@ -18,8 +18,11 @@ Rules (the same for every field):
   finite unless the check says that ``inf`` means "no limit";
 - an interval bound is open or closed as the check says, and the message shows it:
   ``(0, 1]``, ``> 0``, ``>= 0``;
-- a vector has exactly the length asked, each element checked as a number;
-- a matrix is rectangular with the shape asked, every entry a finite number.
+- a vector has exactly the length asked, each element checked as a number; a unit vector
+  has norm 1 within :data:`UNIT_NORM_TOL` (it is not renormalised);
+- a matrix is rectangular with the shape asked, every entry a finite number; an inertia
+  is also symmetric and positive definite (and, with ``physical``, its principal moments
+  obey the triangle inequality).
 
 Assumptions: none beyond the above; no state. Source: project convention (issue 18, one
 meaning per quantity: one validator for "finite real number").
@@ -38,6 +41,11 @@ from dbc.errors import ConfigError
 N_AXES = 3
 # Relative asymmetry tolerated in an inertia matrix (|J − Jᵀ| ≤ this × max |J|).
 INERTIA_SYMMETRY_RTOL = 1e-9
+# Relative slack on the principal-moment triangle inequality λ_i ≤ λ_j + λ_k of a physical
+# body (a thin plate lies on it).
+INERTIA_TRIANGLE_RTOL = 1e-9
+# |‖v‖ − 1| tolerated in a unit vector (catches unnormalised or garbled input).
+UNIT_NORM_TOL = 1e-6
 
 
 def is_real(value: object) -> bool:
@@ -45,17 +53,28 @@ def is_real(value: object) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
+def _bounds(lo: float, hi: float, lo_open: bool, hi_open: bool) -> str:
+    """An interval in words, with its leading space: `` in (0, 1]``, `` > 0``, or ``""``."""
+    has_lo, has_hi = lo > -math.inf, hi < math.inf
+    if has_lo and has_hi:
+        return f" in {'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+    if has_lo:
+        return f" {'>' if lo_open else '>='} {lo:g}"
+    if has_hi:
+        return f" {'<' if hi_open else '<='} {hi:g}"
+    return ""
+
+
+def _inside(x: float, lo: float, hi: float, lo_open: bool, hi_open: bool) -> bool:
+    """Whether ``x`` lies in the interval (each bound open or closed)."""
+    return (lo < x if lo_open else lo <= x) and (x < hi if hi_open else x <= hi)
+
+
 def _describe(lo: float, hi: float, lo_open: bool, hi_open: bool, allow_inf: bool,
               unit: str) -> str:
     """``expected`` of :func:`number` in words."""
     text = "a number" if allow_inf else "a finite number"
-    has_lo, has_hi = lo > -math.inf, hi < math.inf
-    if has_lo and has_hi:
-        text += f" in {'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
-    elif has_lo:
-        text += f" {'>' if lo_open else '>='} {lo:g}"
-    elif has_hi:
-        text += f" {'<' if hi_open else '<='} {hi:g}"
+    text += _bounds(lo, hi, lo_open, hi_open)
     if unit:
         text += f" [{unit}]"
     if allow_inf:
@@ -82,7 +101,7 @@ def number(
     ok = is_real(value)
     x = float(value) if ok else math.nan  # type: ignore[arg-type]
     ok = ok and (math.isfinite(x) or (allow_inf and x == math.inf))
-    ok = ok and (lo < x if lo_open else lo <= x) and (x < hi if hi_open else x <= hi)
+    ok = ok and _inside(x, lo, hi, lo_open, hi_open)
     if not ok:
         raise ConfigError(source, key, value,
                           _describe(lo, hi, lo_open, hi_open, allow_inf, unit))
@@ -126,13 +145,15 @@ def vector(
     value: object,
     size: int | None,
     lo: float = -math.inf,
+    hi: float = math.inf,
     *,
     lo_open: bool = False,
+    hi_open: bool = False,
     unit: str = "",
 ) -> tuple[float, ...]:
-    """``size`` finite numbers (any non-empty length when None), each at least ``lo``."""
+    """``size`` finite numbers (any non-empty length when None), each in [lo, hi]."""
     count = "a non-empty list of" if size is None else str(size)
-    bound = "" if lo == -math.inf else f" {'>' if lo_open else '>='} {lo:g}"
+    bound = _bounds(lo, hi, lo_open, hi_open)
     expected = f"{count} finite numbers{bound}" + (f" [{unit}]" if unit else "")
     items = list(value) if isinstance(value, Iterable) and not isinstance(value, str) else []
     if not items or (size is not None and len(items) != size):
@@ -140,17 +161,49 @@ def vector(
     out: list[float] = []
     for v in items:
         ok = is_real(v) and math.isfinite(float(v))
-        if not (ok and (lo < float(v) if lo_open else lo <= float(v))):
+        if not (ok and _inside(float(v), lo, hi, lo_open, hi_open)):
             raise ConfigError(source, key, value, expected)
         out.append(float(v))
     return tuple(out)
 
 
-def triple(source: str, key: str, value: object, lo: float = -math.inf, *,
-           lo_open: bool = False, unit: str = "") -> tuple[float, float, float]:
-    """Three finite numbers (a per-axis gain or vector), each at least ``lo``."""
-    x = vector(source, key, value, N_AXES, lo, lo_open=lo_open, unit=unit)
+def triple(source: str, key: str, value: object, lo: float = -math.inf,
+           hi: float = math.inf, *, lo_open: bool = False, hi_open: bool = False,
+           unit: str = "") -> tuple[float, float, float]:
+    """Three finite numbers (a per-axis gain or vector), each in [lo, hi]."""
+    x = vector(source, key, value, N_AXES, lo, hi, lo_open=lo_open, hi_open=hi_open,
+               unit=unit)
     return x[0], x[1], x[2]
+
+
+def unit_vector(source: str, key: str, value: object, size: int = N_AXES,
+                tol: float = UNIT_NORM_TOL) -> tuple[float, ...]:
+    """``size`` finite numbers whose Euclidean norm is 1 within ``tol`` (not renormalised)."""
+    x = vector(source, key, value, size)
+    norm = math.sqrt(sum(c * c for c in x))
+    if not abs(norm - 1.0) <= tol:
+        raise ConfigError(source, key, value,
+                          f"a unit vector (|norm - 1| <= {tol:g}; its norm is {norm:.6g})")
+    return x
+
+
+def unit_triple(source: str, key: str, value: object,
+              tol: float = UNIT_NORM_TOL) -> tuple[float, float, float]:
+    """A unit 3-vector (a direction in some axes), as :func:`unit_vector`."""
+    x = unit_vector(source, key, value, N_AXES, tol)
+    return x[0], x[1], x[2]
+
+
+def _real_array(value: object) -> np.ndarray | None:
+    """``value`` (nested sequences or an array) as float64, or None unless every entry is a
+    real number that is not a bool (:func:`is_real`; a ragged nesting is refused too)."""
+    try:
+        entries = np.array(value, dtype=object)
+    except (TypeError, ValueError):
+        return None
+    if not all(is_real(x) for x in entries.ravel()):
+        return None
+    return entries.astype(float)
 
 
 def matrix(source: str, key: str, value: object, rows: int | None = None,
@@ -158,10 +211,9 @@ def matrix(source: str, key: str, value: object, rows: int | None = None,
     """A rectangular matrix of finite numbers as a float64 array (any size when None)."""
     shape = f"{'m' if rows is None else rows}x{'n' if cols is None else cols}"
     expected = f"a {shape} matrix of finite numbers"
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(source, key, value, expected) from None
+    arr = _real_array(value)
+    if arr is None:
+        raise ConfigError(source, key, value, expected)
     ok = arr.ndim == 2 and arr.size > 0 and bool(np.all(np.isfinite(arr)))
     ok = ok and (rows is None or arr.shape[0] == rows) and (cols is None or arr.shape[1] == cols)
     if not ok:
@@ -169,27 +221,35 @@ def matrix(source: str, key: str, value: object, rows: int | None = None,
     return arr
 
 
-def inertia(source: str, key: str, value: object) -> np.ndarray:
+def inertia(source: str, key: str, value: object, *, physical: bool = False) -> np.ndarray:
     """A symmetric positive-definite 3×3 inertia [kg m²] (or its 3 principal moments).
 
-    Returns the symmetrised 3×3 float64 array; the asymmetry tolerated is
-    :data:`INERTIA_SYMMETRY_RTOL` × the largest entry.
+    Returns the symmetrised 3×3 float64 array ``(J + Jᵀ)/2``; the asymmetry tolerated is
+    :data:`INERTIA_SYMMETRY_RTOL` × the largest |entry|. With ``physical`` the principal
+    moments must also obey the triangle inequality λ_max ≤ (λ_1 + λ_2)(1 +
+    :data:`INERTIA_TRIANGLE_RTOL`), as those of any rigid body do. The message says which
+    property failed.
     """
-    expected = "a symmetric positive-definite 3x3 matrix (or 3 moments) of finite numbers"
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ConfigError(source, key, value, expected) from None
-    if arr.shape == (N_AXES,):
+    arr = _real_array(value)
+    if arr is not None and arr.shape == (N_AXES,):
         arr = np.diag(arr)
-    if arr.shape != (N_AXES, N_AXES) or not np.all(np.isfinite(arr)):
-        raise ConfigError(source, key, value, expected)
+    if arr is None or arr.shape != (N_AXES, N_AXES) or not np.all(np.isfinite(arr)):
+        raise ConfigError(source, key, value, "a symmetric positive-definite 3x3 matrix "
+                          "(or 3 moments) of finite numbers")
     scale = float(np.max(np.abs(arr)))
     if not np.allclose(arr, arr.T, rtol=0.0, atol=INERTIA_SYMMETRY_RTOL * scale):
-        raise ConfigError(source, key, value, expected)
+        raise ConfigError(source, key, value, "a symmetric matrix (|J_ij - J_ji| <= "
+                          f"{INERTIA_SYMMETRY_RTOL:g} max|J|)")
     sym = 0.5 * (arr + arr.T)
-    if not float(np.linalg.eigvalsh(sym)[0]) > 0.0:
-        raise ConfigError(source, key, value, expected)
+    moments = np.linalg.eigvalsh(sym)  # ascending
+    if not float(moments[0]) > 0.0:
+        raise ConfigError(source, key, value,
+                          "a positive-definite matrix (every principal moment > 0)")
+    if physical and float(moments[2]) > (float(moments[0]) + float(moments[1])) * (
+        1.0 + INERTIA_TRIANGLE_RTOL
+    ):
+        raise ConfigError(source, key, value, "principal moments obeying the triangle "
+                          "inequality (a physical body)")
     return sym
 
 
