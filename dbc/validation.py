@@ -2,16 +2,21 @@
 
 What it does: one small set of checks, in the contract package so that both sides (the
 flight software and the bench, which never import each other) use the same ones: every
-parameter dataclass of the flight software calls them from its ``__post_init__`` (and the
-strategies from their constructors), so that a bad value is refused the same way
-everywhere: with :class:`dbc.errors.ConfigError` ``(source, key, value, expected)``, where
-``source`` names the dataclass (e.g. ``"PwpfParams"``), ``key`` the field, ``value`` the
-value given and ``expected`` what would have been accepted, in words (``"a finite number
-> 0 [s]"``). The configuration loader (:mod:`flight_sw.config`) re-anchors such an error
-in the scenario file and its dotted key.
+parameter dataclass of the flight software and of the bench's station calls them from
+its ``__post_init__`` (and the strategies, models and fault setters from their
+constructors and methods), and :class:`dbc.schema.Table` calls them for the values of a
+TOML or JSON table. A bad value is refused the same way everywhere: with
+:class:`dbc.errors.ConfigError` ``(source, key, value, expected)``, where ``source`` names
+the dataclass (e.g. ``"PwpfParams"``) or the file, ``key`` the field or the dotted key,
+``value`` the value given and ``expected`` what would have been accepted, in words
+(``"a finite number > 0 [s]"``). The loaders (:mod:`flight_sw.config`,
+:mod:`bench.scenario.parse`) re-anchor a dataclass's error in the scenario file and its
+dotted key.
 
 Inputs: the value as given (any object). Outputs: the value converted to the type the
 dataclass stores (``float``, ``int``, ``bool``, a tuple of floats, a float64 array).
+Units: those of the field (its name carries them); the checks convert none, and a
+``unit`` argument only puts it in the message (``[s]``). Inertia in kg m².
 
 Rules (the same for every field):
 - a "number" is a real number that is not a bool (``True`` is not 1 here); it must be
