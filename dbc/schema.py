@@ -4,7 +4,9 @@ Shared by the bench (scenario files) and the flight software (its configuration 
 both report bad values the same way. A :class:`Table` wraps one TOML table with its
 file name and dotted path, hands out typed values, and at the end :meth:`Table.done`
 rejects any key nobody asked for (so a misspelt key is an error, not a silent default).
-Nothing is ever evaluated: values are data only.
+Nothing is ever evaluated: values are data only. The checks of a value (finite, in its
+range, the length of a vector) are those of :mod:`dbc.validation`, with the file as the
+source and the dotted key as the key.
 """
 
 from __future__ import annotations
@@ -13,9 +15,11 @@ import difflib
 import math
 from typing import Any
 
+from dbc import validation as check
 from dbc.errors import ConfigError
 
 _MISSING = object()
+MATRIX3_ROWS = 3
 NEAR_MISS_CUTOFF = 0.75  # difflib similarity above which a present key is suggested
 
 
@@ -32,6 +36,10 @@ class Table:
 
     def _key(self, key: str) -> str:
         return f"{self._path}.{key}" if self._path else key
+
+    def dotted(self, key: str) -> str:
+        """The dotted key of ``key`` in this table, as errors name it (``vehicle.mass_kg``)."""
+        return self._key(key)
 
     def error(self, key: str, value: object, expected: str) -> ConfigError:
         """A ConfigError for ``key`` of this table."""
@@ -65,22 +73,15 @@ class Table:
     ) -> float:
         """A finite real number in [lo, hi] (or (lo, hi] with ``lo_open``)."""
         v = self.raw(key, default)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise self.error(key, v, "a finite number")
-        if lo is not None and (v < lo or (lo_open and v == lo)):
-            raise self.error(key, v, f"a number {'>' if lo_open else '>='} {lo}")
-        if hi is not None and v > hi:
-            raise self.error(key, v, f"a number <= {hi}")
-        return float(v)
+        return check.number(self._source, self._key(key), v, _lo(lo), _hi(hi), lo_open=lo_open)
 
     def integer(self, key: str, default: Any = _MISSING, *, lo: int | None = None) -> int:
         """An integer >= lo."""
-        v = self.raw(key, default)
-        if isinstance(v, bool) or not isinstance(v, int):
-            raise self.error(key, v, "an integer")
-        if lo is not None and v < lo:
-            raise self.error(key, v, f"an integer >= {lo}")
-        return v
+        return check.integer(self._source, self._key(key), self.raw(key, default), lo)
+
+    def flag(self, key: str, default: Any = _MISSING) -> bool:
+        """A bool (``true`` or ``false``)."""
+        return check.flag(self._source, self._key(key), self.raw(key, default))
 
     def string(self, key: str, default: Any = _MISSING, *, choices: tuple[str, ...] = ()) -> str:
         """A string, one of ``choices`` if given."""
@@ -99,21 +100,18 @@ class Table:
         *,
         lo: float | None = None,
         hi: float | None = None,
+        lo_open: bool = False,
     ) -> tuple[float, ...]:
-        """A list of ``n`` finite numbers, each in [lo, hi] when those are given."""
+        """A list of ``n`` finite numbers, each in [lo, hi] (or (lo, hi] with ``lo_open``)
+        when those are given."""
         v = self.raw(key, default)
-        if (
-            not isinstance(v, list)
-            or len(v) != n
-            or not all(
-                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                for x in v
-            )
-        ):
-            raise self.error(key, v, f"a list of {n} finite numbers")
-        if (lo is not None and min(v) < lo) or (hi is not None and max(v) > hi):
-            raise self.error(key, v, f"a list of {n} numbers in [{lo}, {hi}]")
-        return tuple(float(x) for x in v)
+        return check.vector(self._source, self._key(key), v, n, _lo(lo), _hi(hi),
+                            lo_open=lo_open)
+
+    def unit_vector(self, key: str, n: int, default: Any = _MISSING) -> tuple[float, ...]:
+        """A list of ``n`` finite numbers of Euclidean norm 1 (within
+        :data:`dbc.validation.UNIT_NORM_TOL`; not renormalised)."""
+        return check.unit_vector(self._source, self._key(key), self.raw(key, default), n)
 
     def vector3(self, key: str, default: Any = _MISSING) -> tuple[float, float, float]:
         """A list of 3 finite numbers."""
@@ -126,23 +124,13 @@ class Table:
         return (a, b, c, d)
 
     def matrix3(self, key: str) -> tuple[tuple[float, float, float], ...]:
-        """A 3x3 list of lists of finite numbers."""
+        """A 3x3 list of lists of finite numbers (a bad row is named by its index)."""
         v = self.raw(key)
-        if not isinstance(v, list) or len(v) != 3:
+        if not isinstance(v, list) or len(v) != MATRIX3_ROWS:
             raise self.error(key, v, "a 3x3 matrix (list of three lists of three numbers)")
-        rows = []
-        for i, row in enumerate(v):
-            if (
-                not isinstance(row, list)
-                or len(row) != 3
-                or not all(
-                    isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                    for x in row
-                )
-            ):
-                raise self.error(f"{key}[{i}]", row, "a list of 3 finite numbers")
-            rows.append((float(row[0]), float(row[1]), float(row[2])))
-        return tuple(rows)
+        return tuple(
+            check.triple(self._source, f"{self._key(key)}[{i}]", row) for i, row in enumerate(v)
+        )
 
     def table(self, key: str, default: Any = _MISSING) -> Table:
         """Sub-table ``key`` (an empty one if absent and ``default`` is given)."""
@@ -181,3 +169,13 @@ class Table:
     def path(self) -> str:
         """Dotted path of this table."""
         return self._path
+
+
+def _lo(lo: float | None) -> float:
+    """A lower bound, None meaning none."""
+    return -math.inf if lo is None else lo
+
+
+def _hi(hi: float | None) -> float:
+    """An upper bound, None meaning none."""
+    return math.inf if hi is None else hi

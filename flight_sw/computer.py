@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.allocation.base import Allocator
 from flight_sw.control.base import (
     AttitudeController,

@@ -40,6 +40,7 @@ from bench.station.environment.disturbance import FORCE_FRAMES, DisturbanceParam
 from bench.station.faults import parse_faults
 from bench.station.reference import KIND_STEP, KINDS, ReferenceParams, reference
 from bench.station.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
+from dbc import validation as check
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps, bitrate_range_bps
 from dbc.database import load_database
 from dbc.errors import ConfigError
@@ -51,7 +52,8 @@ DEG_RAD = math.pi / 180.0
 EULER_LIMIT_DEG = 360.0
 SQRT_HOUR_S = 60.0  # sqrt(3600 s)
 S_PER_H = 3600.0
-UNIT_NORM_TOL = 1e-6
+QUAT_SIZE = 4
+VEC3_SIZE = 3
 
 
 def quat_from_euler_zyx(yaw_rad: float, pitch_rad: float, roll_rad: float) -> Quat:
@@ -68,18 +70,8 @@ def quat_from_euler_zyx(yaw_rad: float, pitch_rad: float, roll_rad: float) -> Qu
     return q if q[0] >= 0 else (-q[0], -q[1], -q[2], -q[3])
 
 
-def _unit(t: Table, key: str, n: int) -> tuple[float, ...]:
-    v = t.vector(key, n)
-    norm = math.sqrt(sum(x * x for x in v))
-    if abs(norm - 1.0) > UNIT_NORM_TOL:
-        raise t.error(
-            key, list(v), f"a unit vector (norm 1 +- {UNIT_NORM_TOL}), norm is {norm:.6g}"
-        )
-    return v
-
-
 def _quat(t: Table, key: str) -> Quat:
-    a, b, c, d = _unit(t, key, 4)
+    a, b, c, d = t.unit_vector(key, QUAT_SIZE)
     return (a, b, c, d)
 
 
@@ -108,7 +100,7 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
             geo.append(
                 ThrusterSpec(
                     it.vector("r_thr_B_m", 3),  # type: ignore[arg-type]
-                    _unit(it, "d_thr_B", 3),  # type: ignore[arg-type]
+                    it.unit_vector("d_thr_B", VEC3_SIZE),  # type: ignore[arg-type]
                     it.number("max_thrust_N", lo=0.0, lo_open=True)
                     if it.has("max_thrust_N") else None,
                 )
@@ -131,9 +123,7 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
         if layout == "explicit":
             raise t.error("max_thrust_per_thruster_N", t.raw("max_thrust_per_thruster_N"),
                           "absent with an explicit list (give max_thrust_N per entry)")
-        maxima = t.vector("max_thrust_per_thruster_N", len(geo))
-        if min(maxima) <= 0.0:
-            raise t.error("max_thrust_per_thruster_N", list(maxima), "numbers > 0")
+        maxima = t.vector("max_thrust_per_thruster_N", len(geo), lo=0.0, lo_open=True)
         geo = [dataclasses.replace(g, max_thrust_N=m) for g, m in zip(geo, maxima, strict=True)]
     v = ValveSpec(
         max_thrust_N=t.number("max_thrust_N", lo=0.0, lo_open=True),
@@ -193,7 +183,7 @@ def _sensors(
     st = StarTrackerSpec(
         noise_cross_arcsec=s.number("noise_cross_arcsec", lo=0.0),
         noise_about_arcsec=s.number("noise_about_arcsec", lo=0.0),
-        boresight_B=_unit(s, "boresight_B", 3),  # type: ignore[arg-type]
+        boresight_B=s.unit_vector("boresight_B", VEC3_SIZE),  # type: ignore[arg-type]
     )
     s.done()
     nav = None
@@ -209,11 +199,6 @@ def _opt(t: Table, key: str) -> float | None:
     return t.number(key, lo=0.0) if t.has(key) else None
 
 
-def _bool(t: Table, key: str, default: bool) -> bool:
-    v = t.raw(key, default)
-    if not isinstance(v, bool):
-        raise t.error(key, v, "true or false")
-    return v
 
 
 def _dynamics_environment(root: Table) -> tuple[DynamicsSpec, EnvironmentSpec]:
@@ -225,7 +210,7 @@ def _dynamics_environment(root: Table) -> tuple[DynamicsSpec, EnvironmentSpec]:
     dt.done()
     et = root.table("environment", {})
     env = EnvironmentSpec(
-        gravity_gradient=_bool(et, "gravity_gradient", False),
+        gravity_gradient=et.flag("gravity_gradient", False),
         orbit_radius_m=et.number("orbit_radius_m", dyn.orbit_radius_m, lo=0.0, lo_open=True),
     )
     if dyn.translation == "hcw" and env.orbit_radius_m != dyn.orbit_radius_m:
@@ -283,19 +268,10 @@ def _events(root: Table, duration_s: float) -> tuple[CaptureSpec, ...]:
 def _mrp_coefficients(t: Table) -> tuple[tuple[float, ...], ...]:
     v = t.raw("mrp_coefficients")
     expected = "3 lists (x, y, z) of polynomial coefficients, highest power first"
-    if not isinstance(v, list) or len(v) != 3:
+    if not isinstance(v, list) or len(v) != VEC3_SIZE:
         raise t.error("mrp_coefficients", v, expected)
-    for i, c in enumerate(v):
-        if (
-            not isinstance(c, list)
-            or not c
-            or not all(
-                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                for x in c
-            )
-        ):
-            raise t.error(f"mrp_coefficients[{i}]", c, "a non-empty list of finite numbers")
-    return tuple(tuple(float(x) for x in c) for c in v)
+    key = t.dotted("mrp_coefficients")
+    return tuple(check.vector(t.source, f"{key}[{i}]", c, None) for i, c in enumerate(v))
 
 
 def parse_scenario(data: dict[str, Any], source: str) -> Scenario:

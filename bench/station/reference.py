@@ -32,6 +32,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from bench.station.dynamics.rigid_body import Quat, Vec3, rotate_B_to_N, rotate_N_to_B
+from dbc import validation as check
 from dbc.errors import ConfigError
 
 KIND_STEP = "step"
@@ -92,21 +93,16 @@ class ReferenceParams:
         if self.kind not in KINDS:
             raise ConfigError(self.source, "kind", self.kind, f"one of {KINDS}")
         co = self.mrp_coefficients
-        ok = len(co) == MRP_AXES and all(
-            len(c) >= 1
-            and all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                    for x in c)
-            for c in co
-        )
-        if not ok:
+        if isinstance(co, str) or not isinstance(co, Sequence) or len(co) != MRP_AXES:
             raise ConfigError(
                 self.source, "mrp_coefficients", co, "3 non-empty lists of finite numbers"
             )
+        object.__setattr__(self, "mrp_coefficients", tuple(
+            check.vector(self.source, f"mrp_coefficients[{i}]", c, None) for i, c in enumerate(co)
+        ))
         object.__setattr__(
-            self, "mrp_coefficients", tuple(tuple(float(x) for x in c) for c in co)
+            self, "t_start_s", check.number(self.source, "t_start_s", self.t_start_s)
         )
-        if not math.isfinite(self.t_start_s):
-            raise ConfigError(self.source, "t_start_s", self.t_start_s, "a finite number")
 
 
 def reference_mrp(p: ReferenceParams, t_s: float) -> tuple[Vec3, Vec3]:

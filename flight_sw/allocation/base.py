@@ -46,8 +46,8 @@ from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw import validation as check
 
 MAX_DEMAND_DIM = 6
 # Singular values below RANK_RTOL × the largest count as zero (rank, least-norm solutions).

@@ -84,7 +84,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog, lsq_linear
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.allocation.base import RANK_RTOL, BoundSpec, ControlAllocation
 
 # Smallest component (of a unit-sum null vector) accepted as "strictly positive".

@@ -72,8 +72,8 @@ import numpy as np
 import osqp
 import scipy.sparse as sp
 
+from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw import validation as check
 from flight_sw.allocation.active_set import (
     ACTIVE_RTOL,
     AT_LOWER,

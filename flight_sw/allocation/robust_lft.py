@@ -70,8 +70,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw import validation as check
 from flight_sw.allocation.active_set import FREE, bound_active, box_qp, refine
 from flight_sw.allocation.base import (
     RANK_RTOL,

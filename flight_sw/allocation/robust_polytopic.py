@@ -51,8 +51,8 @@ from typing import Any
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw import validation as check
 from flight_sw.allocation.active_set import bound_active
 from flight_sw.allocation.base import BoundSpec, ControlAllocation, check_bound_spec, frozen
 from flight_sw.allocation.qp_osqp import DEFAULT_REGULARIZATION

@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.schema import Table
-from flight_sw import validation as check
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.fdir.valve_timing import DEFAULT_TIMING, ValveTiming
 

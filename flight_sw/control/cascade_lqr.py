@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solve_continuous_are
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.control.base import error_limit
 from flight_sw.quaternion import error_quaternion
 

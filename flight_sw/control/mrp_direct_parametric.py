@@ -47,9 +47,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import block_diag
 
+from dbc import validation as check
 from dbc.errors import ConfigError
 from flight_sw import mrp
-from flight_sw import validation as check
 from flight_sw.quaternion import cross as cross3
 from flight_sw.quaternion import error_quaternion
 

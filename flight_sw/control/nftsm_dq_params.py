@@ -8,7 +8,7 @@ definite, or 3 principal moments [kg m²]).
 
 Units are in the field names; gains per body axis (``_att``: attitude, the real part of
 the dual surfaces; ``_pos``: position, the dual part). Errors: ConfigError naming the
-dataclass, field and value (:mod:`flight_sw.validation`).
+dataclass, field and value (:mod:`dbc.validation`).
 
 Source: seed 000, eqs. (13)–(17), (25)–(26), Section V (p1 = 0.6, p2 = 0.67,
 δ̂ = 0.05 + ϵ 0.001, K̂ = 20 + ϵ 20, α̂1 = α̂2 = 0.05 + ϵ 0.1, α̂3 = 2 + ϵ 2, m0 = 100 kg,
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.control.dq_error_state import MU_EARTH_M3_S2
 
 N_AXES = 3

@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.control.base import error_limit
 from flight_sw.quaternion import error_quaternion
 

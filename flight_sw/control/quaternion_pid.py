@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.control.quaternion_pd import QuaternionPd, QuaternionPdParams
 from flight_sw.quaternion import error_quaternion, rotation_angle_rad
 

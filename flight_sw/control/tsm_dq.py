@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw import vec3
 from flight_sw.control import dq_error_state as es
 from flight_sw.control.dq_error_state import MU_EARTH_M3_S2

@@ -76,7 +76,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.estimation import rls_kernel as kernel
 
 N_PARAMS = 6  # unique entries of a symmetric 3×3 tensor

@@ -30,7 +30,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from flight_sw import validation as check
+from dbc import validation as check
 
 _SOURCE = "FrozenSensorParams"
 # Fewer than two identical samples cannot show a frozen sensor.

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.fdir.valve_timing import (
     DEFAULT_CLOSE_DELAY_S,
     DEFAULT_COMMAND_DELAY_S,

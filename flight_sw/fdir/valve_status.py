@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from flight_sw import validation as check
+from dbc import validation as check
 from flight_sw.fdir.base import (
     NOTHING,
     FailureKind,

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from flight_sw import validation as check
+from dbc import validation as check
 
 DEFAULT_COMMAND_DELAY_S = 0.0015
 DEFAULT_OPEN_DELAY_S = 0.003

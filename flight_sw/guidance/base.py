@@ -24,8 +24,8 @@ from typing import Protocol
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw import validation as check
 
 QUATERNION_SIZE = 4
 VECTOR_SIZE = 3

@@ -43,9 +43,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
 from flight_sw import mrp
-from flight_sw import validation as check
 from flight_sw.guidance.base import VECTOR_SIZE, AttitudeReference
 
 NS_PER_S = 1_000_000_000

@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw import validation as check
 from flight_sw.guidance.base import QUATERNION_SIZE, VECTOR_SIZE, AttitudeReference
 from flight_sw.quaternion import normalise
 

@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 from mypy_extensions import mypyc_attr
 
-from flight_sw import validation as check
+from dbc import validation as check
 
 _SOURCE = "PwpfParams"
 # Minimum on-time rule: a wanted emission x with MIN_ON_ROUNDING_FRACTION × min_on_s ≤ x <

@@ -35,7 +35,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from flight_sw import validation as check
+from dbc import validation as check
 
 _SOURCE = "RemainderParams"
 

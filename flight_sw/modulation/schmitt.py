@@ -40,7 +40,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from flight_sw import validation as check
+from dbc import validation as check
 
 _SOURCE = "SchmittParams"
 # Default trigger levels (fractions of the minimum fire time), chosen here: fire a

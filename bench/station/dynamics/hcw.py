@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from mypy_extensions import mypyc_attr
 
 from bench.station.dynamics.rigid_body import Vec3
-from dbc.errors import ConfigError
+from dbc import validation as check
 
 MU_EARTH_M3_S2 = 3.986004418e14
 """Earth's gravitational parameter GM [m³/s²] (IERS Conventions 2010, Table 1.1)."""
@@ -61,11 +61,7 @@ class HcwParams:
 
     def __post_init__(self) -> None:
         for key in ("orbit_radius_m", "mu_m3_s2"):
-            v = getattr(self, key)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not (
-                math.isfinite(v) and v > 0.0
-            ):
-                raise ConfigError(self.source, key, v, "a finite number > 0")
+            object.__setattr__(self, key, check.positive(self.source, key, getattr(self, key)))
         object.__setattr__(
             self, "mean_motion_rad_s", mean_motion_rad_s(self.orbit_radius_m, self.mu_m3_s2)
         )

@@ -56,12 +56,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from mypy_extensions import mypyc_attr
 
-from dbc.errors import ConfigError
+from dbc import validation as check
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
@@ -86,10 +85,6 @@ ZERO_VEC3: Vec3 = (0.0, 0.0, 0.0)
 ZERO_WRENCH: Wrench = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 # --- validation tolerances ------------------------------------------------------------
-INERTIA_SYMMETRY_REL_TOL = 1e-9
-"""|J_ij − J_ji| allowed, relative to the largest |J_kl|."""
-INERTIA_TRIANGLE_REL_TOL = 1e-9
-"""Slack on the principal-moment triangle inequality λ_i ≤ λ_j + λ_k (a thin plate is on it)."""
 QUAT_NORM_TOL = 1e-6
 """Allowed |‖q‖ − 1| for quaternions handed to ``make_state``."""
 MATRIX_DIM = 3
@@ -100,10 +95,11 @@ MATRIX_DIM = 3
 class MassProperties:
     """Mass [kg] and inertia tensor about the centre of mass in body axes [kg·m²].
 
-    ``inertia_B_kgm2`` must be 3×3, finite, symmetric within ``INERTIA_SYMMETRY_REL_TOL``
-    (it is stored symmetrised), positive definite and physically realisable (principal
-    moments obey the triangle inequality). The flat row-major tensor, its inverse and
-    1/m are precomputed for the hot path.
+    ``mass_kg`` is a finite number > 0; ``inertia_B_kgm2`` must be 3×3, finite, symmetric
+    within ``dbc.validation.INERTIA_SYMMETRY_RTOL``, positive definite and physically
+    realisable (principal moments obey the triangle inequality), as
+    :func:`dbc.validation.inertia` checks it. The flat row-major tensor (symmetrised), its
+    inverse and 1/m are precomputed for the hot path.
     """
 
     mass_kg: float
@@ -115,61 +111,20 @@ class MassProperties:
 
     def __post_init__(self) -> None:
         src = self.source
-        m = self.mass_kg
-        if (
-            isinstance(m, bool)
-            or not isinstance(m, (int, float))
-            or not (math.isfinite(m) and m > 0.0)
-        ):
-            raise ConfigError(src, "mass_kg", m, "a finite number > 0")
-        rows = _as_matrix3(self.inertia_B_kgm2, src, "inertia_B_kgm2")
-        j = np.array(rows, dtype=float)
-        scale = float(np.max(np.abs(j)))
-        if scale <= 0.0:
-            raise ConfigError(src, "inertia_B_kgm2", self.inertia_B_kgm2, "a non-zero tensor")
-        if float(np.max(np.abs(j - j.T))) > INERTIA_SYMMETRY_REL_TOL * scale:
-            raise ConfigError(
-                src,
-                "inertia_B_kgm2",
-                self.inertia_B_kgm2,
-                f"a symmetric tensor (|J_ij - J_ji| <= {INERTIA_SYMMETRY_REL_TOL:g}·max|J|)",
-            )
-        j = 0.5 * (j + j.T)
-        eig = np.linalg.eigvalsh(j)
-        if float(eig[0]) <= 0.0:
-            raise ConfigError(
-                src, "inertia_B_kgm2", self.inertia_B_kgm2, "a positive definite tensor"
-            )
-        if float(eig[2]) > (float(eig[0]) + float(eig[1])) * (1.0 + INERTIA_TRIANGLE_REL_TOL):
-            raise ConfigError(
-                src,
-                "inertia_B_kgm2",
-                self.inertia_B_kgm2,
-                "principal moments obeying the triangle inequality (a physical body)",
-            )
+        # getattr: the fields as given (compiled code would cast a read to its type first)
+        m = check.positive(src, "mass_kg", getattr(self, "mass_kg"))  # noqa: B009
+        given = getattr(self, "inertia_B_kgm2")  # noqa: B009
+        rows = check.matrix(src, "inertia_B_kgm2", given, MATRIX_DIM, MATRIX_DIM)
+        j = check.inertia(src, "inertia_B_kgm2", given, physical=True)
         j_inv = np.linalg.inv(j)
         j_inv = 0.5 * (j_inv + j_inv.T)
-        object.__setattr__(self, "mass_kg", float(m))
+        object.__setattr__(self, "mass_kg", m)
         object.__setattr__(self, "inertia_B_kgm2", tuple(tuple(map(float, r)) for r in rows))
         object.__setattr__(self, "inertia_flat_B_kgm2", tuple(float(x) for x in j.ravel()))
         object.__setattr__(
             self, "inertia_inv_flat_B_per_kgm2", tuple(float(x) for x in j_inv.ravel())
         )
-        object.__setattr__(self, "inv_mass_per_kg", 1.0 / float(m))
-
-
-def _as_matrix3(value: Any, source: str, key: str) -> tuple[tuple[float, float, float], ...]:
-    """Return ``value`` as a 3×3 tuple of finite floats, or raise ConfigError."""
-    expected = "a 3×3 matrix of finite numbers"
-    try:
-        rows = tuple(tuple(float(x) for x in row) for row in value)
-    except (TypeError, ValueError):
-        raise ConfigError(source, key, value, expected) from None
-    if len(rows) != MATRIX_DIM or any(len(r) != MATRIX_DIM for r in rows):
-        raise ConfigError(source, key, value, expected)
-    if not all(math.isfinite(x) for r in rows for x in r):
-        raise ConfigError(source, key, value, expected)
-    return tuple((r[0], r[1], r[2]) for r in rows)
+        object.__setattr__(self, "inv_mass_per_kg", 1.0 / m)
 
 
 # --- quaternion and frame helpers ---------------------------------------------------------

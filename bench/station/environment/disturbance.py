@@ -33,24 +33,12 @@ from bench.station.dynamics.rigid_body import (
     rotate_N_to_B,
 )
 from bench.station.dynamics.translation import InertialTranslation, TranslationModel
+from dbc import validation as check
 from dbc.errors import ConfigError
 
 FORCE_FRAMES = ("body", "nav")
 """Frames a disturbance force may be given in (module docstring)."""
 VEC3_LEN = 3
-
-
-def _finite(v: object) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _vec3(value: object, source: str, key: str) -> Vec3:
-    if not isinstance(value, (tuple, list)):
-        raise ConfigError(source, key, value, "3 finite numbers")
-    seq = [x for x in value if _finite(x)]
-    if len(seq) != VEC3_LEN or len(value) != VEC3_LEN:
-        raise ConfigError(source, key, value, "3 finite numbers")
-    return (float(seq[0]), float(seq[1]), float(seq[2]))
 
 
 @mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
@@ -64,11 +52,12 @@ class Sinusoid:
     source: str = field(default="Sinusoid", compare=False, repr=False, kw_only=True)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "amplitude", _vec3(self.amplitude, self.source, "amplitude"))
+        # getattr: the fields as given (compiled code would cast a read to its type first)
+        src = self.source
+        amplitude = getattr(self, "amplitude")  # noqa: B009
+        object.__setattr__(self, "amplitude", check.triple(src, "amplitude", amplitude))
         for key in ("omega_rad_s", "phase_rad"):
-            if not _finite(getattr(self, key)):
-                raise ConfigError(self.source, key, getattr(self, key), "a finite number")
-            object.__setattr__(self, key, float(getattr(self, key)))
+            object.__setattr__(self, key, check.number(src, key, getattr(self, key)))
 
 
 @mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
@@ -85,8 +74,9 @@ class DisturbanceParams:
 
     def __post_init__(self) -> None:
         src = self.source
-        object.__setattr__(self, "force_N", _vec3(self.force_N, src, "force_N"))
-        object.__setattr__(self, "torque_Nm", _vec3(self.torque_Nm, src, "torque_Nm"))
+        # getattr: the fields as given (compiled code would cast a read to Vec3 first)
+        for key in ("force_N", "torque_Nm"):
+            object.__setattr__(self, key, check.triple(src, key, getattr(self, key)))
         for key in ("force_sinusoids", "torque_sinusoids"):
             items = tuple(getattr(self, key))
             if not all(isinstance(s, Sinusoid) for s in items):

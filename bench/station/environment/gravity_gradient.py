@@ -30,7 +30,7 @@ from mypy_extensions import mypyc_attr
 
 from bench.station.dynamics.hcw import MU_EARTH_M3_S2, SEED000_ORBIT_RADIUS_M, mean_motion_rad_s
 from bench.station.dynamics.rigid_body import MassProperties, Quat, Vec3, Wrench, rotate_N_to_B
-from dbc.errors import ConfigError
+from dbc import validation as check
 
 GG_FACTOR = 3.0
 """The 3 of 3μ/R³."""
@@ -47,11 +47,7 @@ class GravityGradientParams:
 
     def __post_init__(self) -> None:
         for key in ("orbit_radius_m", "mu_m3_s2"):
-            v = getattr(self, key)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not (
-                math.isfinite(v) and v > 0.0
-            ):
-                raise ConfigError(self.source, key, v, "a finite number > 0")
+            object.__setattr__(self, key, check.positive(self.source, key, getattr(self, key)))
 
 
 def radial_unit_I(n_rad_s: float, t_s: float) -> Vec3:

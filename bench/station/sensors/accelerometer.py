@@ -44,11 +44,10 @@ from bench.station.sensors.gyro import (
     DEFAULT_PERIOD_S,
     S_PER_NS,
     InertialSensor,
-    check_number,
-    check_vec3,
     output_limit,
     three_axis_sample,
 )
+from dbc import validation as check
 from dbc.errors import ConfigError
 
 
@@ -78,11 +77,11 @@ class AccelerometerParams:
         src = self.source
         put = object.__setattr__
         given = getattr(self, "bias_m_s2")  # noqa: B009 - uncast (see setup.py)
-        put(self, "bias_m_s2", check_vec3(given, src, "bias_m_s2"))
+        put(self, "bias_m_s2", check.triple(src, "bias_m_s2", given))
         for key in ("vrw_m_s_sqrt_s", "bias_rw_m_s2_sqrt_s", "lsb_m_s2"):
-            put(self, key, check_number(getattr(self, key), src, key, positive=False))
-        put(self, "period_s", check_number(self.period_s, src, "period_s", positive=True))
-        rng_ = check_number(self.range_m_s2, src, "range_m_s2", positive=True, allow_inf=True)
+            put(self, key, check.non_negative(src, key, getattr(self, key)))
+        put(self, "period_s", check.positive(src, "period_s", self.period_s))
+        rng_ = check.limit(src, "range_m_s2", self.range_m_s2)
         if rng_ < self.lsb_m_s2:
             raise ConfigError(src, "range_m_s2", self.range_m_s2, "a range >= lsb_m_s2")
         put(self, "range_m_s2", rng_)

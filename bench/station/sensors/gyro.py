@@ -61,6 +61,7 @@ import numpy as np
 from mypy_extensions import mypyc_attr
 
 from bench.station.dynamics.rigid_body import Vec3
+from dbc import validation as check
 from dbc.errors import ConfigError, ThrusterHilError
 from dbc.faults import BIAS_JUMP, FROZEN, NOISE, OUTAGE
 
@@ -139,34 +140,6 @@ def three_axis_sample(
     return (out[0], out[1], out[2]), (bx, by, bz)
 
 
-def check_vec3(value: object, source: str, key: str) -> Vec3:
-    """``value`` as a finite 3-tuple of floats, or ConfigError naming ``key``."""
-    expected = "3 finite numbers"
-    try:
-        seq = tuple(float(x) for x in value)  # type: ignore[attr-defined]
-    except (TypeError, ValueError):
-        raise ConfigError(source, key, value, expected) from None
-    if len(seq) != AXES or not all(math.isfinite(x) for x in seq):
-        raise ConfigError(source, key, value, expected)
-    return (seq[0], seq[1], seq[2])
-
-
-def check_number(
-    value: object, source: str, key: str, *, positive: bool, allow_inf: bool = False
-) -> float:
-    """``value`` as a float ≥ 0 (> 0 if ``positive``; +inf only if ``allow_inf``)."""
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if ok:
-        x = float(value)  # type: ignore[arg-type]
-        ok = (math.isfinite(x) or (allow_inf and x == math.inf)) and (
-            x > 0.0 if positive else x >= 0.0
-        )
-    if not ok:
-        expected = "a number > 0" if positive else "a number >= 0"
-        raise ConfigError(source, key, value, expected + ("" if allow_inf else " (finite)"))
-    return float(value)  # type: ignore[arg-type]
-
-
 def check_fault_kind(
     kind: str, params: Mapping[str, object], source: str, allowed: Mapping[str, tuple[str, ...]]
 ) -> None:
@@ -213,11 +186,11 @@ class GyroParams:
         src = self.source
         put = object.__setattr__
         given = getattr(self, "bias_rad_s")  # noqa: B009 - uncast (see setup.py)
-        put(self, "bias_rad_s", check_vec3(given, src, "bias_rad_s"))
+        put(self, "bias_rad_s", check.triple(src, "bias_rad_s", given))
         for key in ("bias_rw_rad_s_sqrt_s", "arw_rad_sqrt_s", "lsb_rad_s"):
-            put(self, key, check_number(getattr(self, key), src, key, positive=False))
-        put(self, "period_s", check_number(self.period_s, src, "period_s", positive=True))
-        rng_ = check_number(self.range_rad_s, src, "range_rad_s", positive=True, allow_inf=True)
+            put(self, key, check.non_negative(src, key, getattr(self, key)))
+        put(self, "period_s", check.positive(src, "period_s", self.period_s))
+        rng_ = check.limit(src, "range_rad_s", self.range_rad_s)
         if rng_ < self.lsb_rad_s:
             raise ConfigError(src, "range_rad_s", self.range_rad_s, "a range >= lsb_rad_s")
         put(self, "range_rad_s", rng_)
@@ -335,14 +308,14 @@ class InertialSensor:
         check_fault_kind(kind, params, source, self.fault_params())
         recorded: SensorFaultParams = {}
         if kind == FAULT_BIAS_JUMP:
-            jump = check_vec3(params[self._JUMP_KEY], source, self._JUMP_KEY)
+            jump = check.triple(source, self._JUMP_KEY, params[self._JUMP_KEY])
             recorded[self._JUMP_KEY] = jump
             self._remove(kind)
             b = self._bias
             self._bias = (b[0] + jump[0], b[1] + jump[1], b[2] + jump[2])
             self._jump = jump
         elif kind == FAULT_NOISE:
-            factor = check_number(params["factor"], source, "factor", positive=False)
+            factor = check.non_negative(source, "factor", params["factor"])
             recorded["factor"] = factor
             self._white_density = self._white_nominal * factor
         self._faults[kind] = recorded

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dbc.errors import ConfigError
+from dbc import validation as check
 
 Vec3 = tuple[float, float, float]
 
@@ -27,9 +27,8 @@ class RelNavParams:
 
     def __post_init__(self) -> None:
         for key in ("noise_pos_m", "noise_vel_m_s"):
-            v = getattr(self, key)
-            if not v >= 0.0:
-                raise ConfigError("RelNavParams", key, v, "a number >= 0")
+            value = check.non_negative("RelNavParams", key, getattr(self, key))
+            object.__setattr__(self, key, value)
 
 
 class RelNav:

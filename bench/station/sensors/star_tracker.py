@@ -60,14 +60,11 @@ from bench.station.sensors.gyro import (
     FAULT_OUTAGE,
     SensorFaultParams,
     check_fault_kind,
-    check_number,
-    check_vec3,
 )
+from dbc import validation as check
 from dbc.errors import ConfigError
 
 RAD_PER_ARCSEC = math.pi / (180.0 * 3600.0)
-UNIT_NORM_TOL = 1e-6
-"""Allowed |‖boresight_B‖ − 1|."""
 NORMALS_PER_SAMPLE = 3
 SMALL_ANGLE_RAD = 1e-12
 """Below this rotation angle δq is taken as identity plus θ/2 (avoids 0/0)."""
@@ -106,17 +103,9 @@ class StarTrackerParams:
         src = self.source
         put = object.__setattr__
         for key in ("noise_cross_arcsec", "noise_about_arcsec"):
-            put(self, key, check_number(getattr(self, key), src, key, positive=False))
+            put(self, key, check.non_negative(src, key, getattr(self, key)))
         given = getattr(self, "boresight_B")  # noqa: B009 - uncast (see setup.py)
-        b = check_vec3(given, src, "boresight_B")
-        if not abs(math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]) - 1.0) <= UNIT_NORM_TOL:
-            raise ConfigError(
-                src,
-                "boresight_B",
-                self.boresight_B,
-                f"a unit vector (|norm - 1| <= {UNIT_NORM_TOL:g})",
-            )
-        put(self, "boresight_B", b)
+        put(self, "boresight_B", check.unit_triple(src, "boresight_B", given))
 
 
 def _cross_axes(b: Vec3) -> tuple[Vec3, Vec3]:
@@ -197,11 +186,11 @@ class StarTracker:
         check_fault_kind(kind, params, source, STAR_TRACKER_FAULT_PARAMS)
         recorded: SensorFaultParams = {}
         if kind == FAULT_NOISE:
-            factor = check_number(params["factor"], source, "factor", positive=False)
+            factor = check.non_negative(source, "factor", params["factor"])
             recorded["factor"] = factor
             self._set_noise_factor(factor)
         elif kind == FAULT_BIAS_JUMP:
-            beta = check_vec3(params["misalignment_arcsec"], source, "misalignment_arcsec")
+            beta = check.triple(source, "misalignment_arcsec", params["misalignment_arcsec"])
             recorded["misalignment_arcsec"] = beta
             self._bias_q = rotation_vector_quat(
                 (beta[0] * RAD_PER_ARCSEC, beta[1] * RAD_PER_ARCSEC, beta[2] * RAD_PER_ARCSEC)

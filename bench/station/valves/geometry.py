@@ -32,27 +32,14 @@ from mypy_extensions import mypyc_attr
 
 from bench.station.dynamics.rigid_body import Vec3, quat_from_axis_angle, rotate_B_to_N
 from bench.station.valves.params import FaultParams
+from dbc import validation as check
 from dbc.errors import ConfigError
 from dbc.faults import MISALIGNED
 
-UNIT_NORM_TOL = 1e-6
-"""Allowed |‖d_thr_B‖ − 1|."""
-VEC3_LEN = 3
 FAULT_MISALIGNED = MISALIGNED
 MISALIGNED_PARAMS = ("angle_deg", "axis_B")
 MAX_MISALIGNMENT_DEG = 180.0
 """|angle_deg| of a ``misaligned`` fault is at most this (any rotation is reachable)."""
-
-
-def _vec3(value: object, source: str, key: str) -> Vec3:
-    expected = "3 finite numbers"
-    try:
-        seq = tuple(float(x) for x in value)  # type: ignore[attr-defined]
-    except (TypeError, ValueError):
-        raise ConfigError(source, key, value, expected) from None
-    if len(seq) != VEC3_LEN or not all(math.isfinite(x) for x in seq):
-        raise ConfigError(source, key, value, expected)
-    return (seq[0], seq[1], seq[2])
 
 
 @mypyc_attr(native_class=False)  # validates its own field types (see setup.py)
@@ -68,16 +55,8 @@ class ThrusterGeometry:
 
     def __post_init__(self) -> None:
         # getattr: the fields as given (compiled code would cast a read to Vec3 first)
-        r = _vec3(getattr(self, "r_thr_B_m"), self.source, "r_thr_B_m")  # noqa: B009
-        d = _vec3(getattr(self, "d_thr_B"), self.source, "d_thr_B")  # noqa: B009
-        norm = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-        if not abs(norm - 1.0) <= UNIT_NORM_TOL:
-            raise ConfigError(
-                self.source,
-                "d_thr_B",
-                self.d_thr_B,
-                f"a unit vector (|norm - 1| <= {UNIT_NORM_TOL:g})",
-            )
+        r = check.triple(self.source, "r_thr_B_m", getattr(self, "r_thr_B_m"))  # noqa: B009
+        d = check.unit_triple(self.source, "d_thr_B", getattr(self, "d_thr_B"))  # noqa: B009
         object.__setattr__(self, "r_thr_B_m", r)
         object.__setattr__(self, "d_thr_B", d)
         object.__setattr__(
@@ -99,30 +78,15 @@ def misaligned_geometry(
     for key in MISALIGNED_PARAMS:
         if key not in params:
             raise ConfigError(source, key, None, f"a value (required by {FAULT_MISALIGNED!r})")
-    angle = params["angle_deg"]
-    if (
-        isinstance(angle, bool)
-        or not isinstance(angle, (int, float))
-        or not (math.isfinite(angle) and abs(angle) <= MAX_MISALIGNMENT_DEG)
-    ):
-        raise ConfigError(
-            source,
-            "angle_deg",
-            angle,
-            f"a number in [-{MAX_MISALIGNMENT_DEG:g}, {MAX_MISALIGNMENT_DEG:g}]",
-        )
-    axis = _vec3(params["axis_B"], source, "axis_B")
-    if not abs(math.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2) - 1.0) <= UNIT_NORM_TOL:
-        raise ConfigError(
-            source,
-            "axis_B",
-            params["axis_B"],
-            f"a unit vector (|norm - 1| <= {UNIT_NORM_TOL:g})",
-        )
+    angle = check.number(
+        source, "angle_deg", params["angle_deg"], -MAX_MISALIGNMENT_DEG, MAX_MISALIGNMENT_DEG,
+        unit="deg",
+    )
+    axis = check.unit_triple(source, "axis_B", params["axis_B"])
     d = rotate_B_to_N(quat_from_axis_angle(axis, math.radians(angle)), nominal.d_thr_B)
     # Renormalise away round-off so the geometry stays a unit direction.
     n = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
     rotated = ThrusterGeometry(
         nominal.r_thr_B_m, (d[0] / n, d[1] / n, d[2] / n), source=nominal.source
     )
-    return {"angle_deg": float(angle), "axis_B": axis}, rotated
+    return {"angle_deg": angle, "axis_B": axis}, rotated

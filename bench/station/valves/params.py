@@ -24,13 +24,13 @@ profile and the thruster set.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 from mypy_extensions import mypyc_attr
 
+from dbc import validation as check
 from dbc.errors import ConfigError
 from dbc.faults import DEGRADED, DELAYED, INTERMITTENT, LEAK, STUCK_CLOSED, STUCK_OPEN
 
@@ -77,25 +77,6 @@ def _require(ok: bool, source: str, key: str, value: object, expected: str) -> N
         raise ConfigError(source, key, value, expected)
 
 
-def _is_real(value: object) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def _fault_number(
-    source: str, key: str, value: object, lo: float, hi: float, expected: str = ""
-) -> float:
-    """``value`` as a finite float in [lo, hi], or ConfigError naming ``key``."""
-    x = float(value) if _is_real(value) else math.nan  # type: ignore[arg-type]
-    _require(
-        math.isfinite(x) and lo <= x <= hi,
-        source,
-        key,
-        value,
-        expected or f"a number in [{lo:g}, {hi:g}]",
-    )
-    return x
-
-
 def check_fault_params(
     kind: str, params: Mapping[str, object], source: str, max_thrust_N: float
 ) -> _ValveFaultParams:
@@ -123,20 +104,18 @@ def check_fault_params(
         _require(isinstance(rng, np.random.Generator), source, "rng", rng, "a numpy Generator")
     out: _ValveFaultParams = {}
     if kind == FAULT_DEGRADED:
-        out["factor"] = _fault_number(source, "factor", params["factor"], 0.0, 1.0)
+        out["factor"] = check.number(source, "factor", params["factor"], 0.0, 1.0)
     elif kind == FAULT_DELAYED:
-        out["extra_delay_s"] = _fault_number(
-            source, "extra_delay_s", params["extra_delay_s"], 0.0, math.inf, "a finite number >= 0"
-        )
+        out["extra_delay_s"] = check.non_negative(source, "extra_delay_s", params["extra_delay_s"])
     elif kind == FAULT_INTERMITTENT:
-        out["dropout_probability"] = _fault_number(
+        out["dropout_probability"] = check.number(
             source, "dropout_probability", params["dropout_probability"], 0.0, 1.0
         )
     elif kind == FAULT_LEAK:
-        value = params["thrust_N"]
-        expected = f"a number in (0, {max_thrust_N:g}] (at most max_thrust_N)"
-        out["thrust_N"] = _fault_number(source, "thrust_N", value, 0.0, max_thrust_N, expected)
-        _require(out["thrust_N"] > 0.0, source, "thrust_N", value, expected)
+        # at most the valve's max_thrust_N
+        out["thrust_N"] = check.number(
+            source, "thrust_N", params["thrust_N"], 0.0, max_thrust_N, lo_open=True, unit="N"
+        )
     return out
 
 
@@ -168,17 +147,12 @@ class ValveParams:
 
     def __post_init__(self) -> None:
         src = self.source
-        for key in ("max_thrust_N", "isp_s", "rise_tau_s", "tail_tau_s"):
-            v = getattr(self, key)
-            _require(
-                _is_real(v) and math.isfinite(v) and v > 0.0, src, key, v, "a finite number > 0"
-            )
-        for key in ("open_delay_s", "close_delay_s", "min_on_s"):
-            v = getattr(self, key)
-            _require(
-                _is_real(v) and math.isfinite(v) and v >= 0.0, src, key, v, "a finite number >= 0"
-            )
         put = object.__setattr__
+        # getattr: the fields as given (compiled code would cast a read to float first)
+        for key in ("max_thrust_N", "isp_s", "rise_tau_s", "tail_tau_s"):
+            put(self, key, check.positive(src, key, getattr(self, key)))
+        for key in ("open_delay_s", "close_delay_s", "min_on_s"):
+            put(self, key, check.non_negative(src, key, getattr(self, key)))
         put(self, "open_delay_ns", round(self.open_delay_s * NS_PER_S))
         put(self, "close_delay_ns", round(self.close_delay_s * NS_PER_S))
         put(self, "min_on_ns", round(self.min_on_s * NS_PER_S))

@@ -49,6 +49,7 @@ from bench.station.valves.params import (
     ValveParams,
     check_fault_params,
 )
+from dbc import validation as check
 from dbc.errors import ConfigError
 
 UNSUPPORTED_FAULTS = frozenset({FAULT_DELAYED, FAULT_INTERMITTENT})
@@ -61,10 +62,8 @@ class ThrottledValve:
     def __init__(
         self, params: ValveParams, period_ns: int, rng: np.random.Generator | None = None
     ) -> None:
-        if isinstance(period_ns, bool) or not isinstance(period_ns, int) or period_ns <= 0:
-            raise ConfigError("ThrottledValve", "period_ns", period_ns, "an integer > 0")
         self.params = params
-        self.period_ns = period_ns
+        self.period_ns = check.integer("ThrottledValve", "period_ns", period_ns, lo=1)
         self.openings = 0
         self.dropped_pulses = 0
         self.idle_from_ns = -NEVER_NS

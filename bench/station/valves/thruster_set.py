@@ -61,14 +61,10 @@ import numpy as np
 
 from bench.station.dynamics.rigid_body import Vec3, Wrench
 from bench.station.valves.base import ValveModel
-from bench.station.valves.geometry import (
-    FAULT_MISALIGNED,
-    ThrusterGeometry,
-    _vec3,
-    misaligned_geometry,
-)
+from bench.station.valves.geometry import FAULT_MISALIGNED, ThrusterGeometry, misaligned_geometry
 from bench.station.valves.params import FAULT_KINDS, S_PER_NS, FaultParams, ValveParams
 from bench.station.valves.valve import Valve
+from dbc import validation as check
 from dbc.errors import ConfigError
 
 G0_M_S2 = 9.80665
@@ -171,8 +167,7 @@ class ThrusterSet:
         if not geoms or not all(isinstance(g, ThrusterGeometry) for g in geoms):
             raise ConfigError(source, "geometries", geometries, "one or more ThrusterGeometry")
         plist = _per_thruster_params(params, len(geoms), source)
-        if isinstance(g0_m_s2, bool) or not (math.isfinite(g0_m_s2) and g0_m_s2 > 0.0):
-            raise ConfigError(source, "g0_m_s2", g0_m_s2, "a finite number > 0")
+        g0 = check.positive(source, "g0_m_s2", g0_m_s2)
         rngs = _valve_rngs(rng, len(geoms), source)
         self._source = source
         self.geometries = geoms
@@ -182,7 +177,7 @@ class ThrusterSet:
         self.valves: tuple[ValveModel, ...] = tuple(
             make(p, r) for p, r in zip(plist, rngs, strict=True)
         )
-        self.g0_m_s2 = float(g0_m_s2)
+        self.g0_m_s2 = g0
         self._impulse_Ns = [0.0] * len(geoms)
         # Active misalignments: index → (recorded parameters, rotated geometry).
         self._misalignment: dict[int, tuple[FaultParams, ThrusterGeometry]] = {}
@@ -216,7 +211,7 @@ class ThrusterSet:
         Directions and active misalignments are kept. Applies to every wrench evaluated
         after the call (call it at a step boundary).
         """
-        c = _vec3(com_B_m, self._source, "com_B_m")
+        c = check.triple(self._source, "com_B_m", com_B_m)
         self._com_B_m = c
         self.geometries = tuple(
             ThrusterGeometry(
