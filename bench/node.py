@@ -72,14 +72,16 @@ class Clock:
 class BenchNode:
     """One bench run on one bus."""
 
-    realtime_loop: type[Realtime] = Realtime  # the realtime loop (tests instrument it)
 
     def __init__(self, sc: Scenario, db: Database, bus: can.BusABC, run_dir: Path, mode: str,
                  seed: int, bus_spec: str,
                  progress: Callable[[float, float], None] | None = None,
-                 clock: Clock | None = None) -> None:
+                 clock: Clock | None = None,
+                 realtime_loop: type[Realtime] = Realtime) -> None:
+        """``realtime_loop``: the realtime loop's class (tests instrument it by subclassing)."""
         self.sc, self.db, self.bus, self.run_dir = sc, db, bus, run_dir
         self.mode, self.seed, self.bus_spec, self.progress = mode, seed, bus_spec, progress
+        self.realtime_loop = realtime_loop
         self.clock = clock or Clock()
         self.icd = icd = Icd.from_database(db)
         lockstep = mode == "lockstep"

@@ -16,6 +16,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import can
+from mypy_extensions import mypyc_attr
 
 from bench.station.fault_book import Event
 from bench.station.plant import STEP_NS
@@ -31,6 +32,7 @@ RT_FRAMES_PER_PASS = 64  # realtime: frames read between two steps toward the wa
 FLUSH_EVERY_CYCLES = 5  # run files go to disk this often (and the progress line is updated)
 
 
+@mypyc_attr(allow_interpreted_subclasses=True)  # tests count the frames it handles
 class Realtime:
     """One realtime run of a bench node, paced by ``clock``."""
 

@@ -121,13 +121,9 @@ def _run(tmp_path: Path, duration_s: float, speedup: int,
             counts.handled += 1
             super().frame(msg)
 
-    class CountingNode(BenchNode):
-        """A bench node whose realtime loop counts the frames it handles."""
-
-        realtime_loop = CountingLoop
 
     scenario = load_scenario(SCENARIO, overrides)
-    node = CountingNode(scenario, db, bus, tmp_path, "realtime", 1, spec)
+    node = BenchNode(scenario, db, bus, tmp_path, "realtime", 1, spec, realtime_loop=CountingLoop)
     recv = bus.recv
 
     def counting_recv(timeout: float | None = None) -> can.Message | None:
