@@ -63,6 +63,7 @@ class Lockstep:
             wire.flush()
             self._collect(k, wire.last_rx_ns + delay_ns)
             n.integrate_to(t_k + period)
+            n.check_fsw_alive()
             if k % FLUSH_EVERY_CYCLES == 0 and n.progress is not None:
                 n.progress(t_k / NS_PER_S, duration_s)
             results.cycle_wall_ns.append(clock.now_ns() - cycle_wall0)

@@ -37,7 +37,7 @@ from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
 from bench.station.fault_book import Event
 from bench.station.plant import STEP_NS
-from bench.station.station import Station
+from bench.station.station import WATCHDOG_PERIODS, Station
 from bench.wire.receipt import Receipt
 from bench.wire.timing.arbiter import bus_off_recovery_ns
 from bench.wire.trace import TraceRecorder
@@ -108,6 +108,7 @@ class BenchNode:
                                round(sc.valve.open_delay_s * NS_PER_S))
         self.lockstep_spin_s = 0.0  # poll this long before blocking (transport.lockstep)
         self.fsw_alive: Callable[[], bool] | None = None
+        self.fsw_exit_ns: int | None = None  # when the flight-software process was found gone
         self.started = False  # the run has begun (live fault commands are taken)
         self.last_sync_ns = 0  # lockstep: time of the run's last SYNC
         self._samples: list[tuple[str, dict[str, float | int]]] = []
@@ -203,6 +204,22 @@ class BenchNode:
         elif name == "FSW_FDIR":
             fsw.on_fdir(s, st.t_ns, events)
         self._fsw_heard_wall_ns = now_wall
+
+    def check_fsw_alive(self) -> None:
+        """The flight-software process gone: record when; once the valve watchdog has closed
+        every valve (or ``WATCHDOG_PERIODS`` + 1 periods later), end the run as a run error."""
+        st = self.station
+        if self.fsw_exit_ns is None:
+            if self.fsw_alive is None or self.fsw_alive():
+                return
+            self.fsw_exit_ns = st.t_ns
+            self._events([(st.t_ns, "fsw_exited", {})])
+        grace_ns = (WATCHDOG_PERIODS + 1) * self.period_ns
+        if st.watchdog_tripped or st.t_ns - self.fsw_exit_ns > grace_ns:
+            closed = ("the valve watchdog closed every valve" if st.watchdog_tripped
+                      else "its last commands had ended")
+            raise RunError(f"the flight software exited during the run (found gone at "
+                           f"{self.fsw_exit_ns / NS_PER_S:g} s of simulated time); {closed}")
 
     def _second_sender(self) -> None:
         """Evidence of a second sender raises BENCH_STATUS.Health's flag (once)."""

@@ -70,6 +70,7 @@ class Realtime:
                     break  # back to stepping; the rest stays queued for the next pass
                 msg = n.bus.recv(timeout=0.0)
             if st.t_ns >= next_progress:
+                n.check_fsw_alive()
                 n.trace.flush()
                 results.flush()
                 if n.progress is not None:

@@ -1,7 +1,7 @@
 """Flight-software entry point: ``python -m flight_sw`` / ``thruster-hil-fsw``.
 
 Opens the bus, builds the flight computer from ``--config`` and runs it in lockstep (one
-cycle per SYNC) or realtime (own timer) until SIGTERM/SIGINT. ``--check`` only validates
+cycle per SYNC) or realtime (own timer) until SIGTERM/SIGINT/SIGHUP. ``--check`` only validates
 the configuration. ``--rx-log`` (realtime) logs when each frame arrived
 (:mod:`flight_sw.rx_log`). Exit codes: 0 ok, 2 bad configuration, bus or log path (and
 the reason, as a ``thruster-hil/fsw-refusal`` record of dbc.contract, in the ``--stats``

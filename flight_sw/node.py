@@ -20,11 +20,14 @@ Modes: ``lockstep`` — one control cycle per SYNC(k), at the simulation time it
 ``realtime`` — cycles on this process's own monotonic timer (period from the DBC), with
 overruns counted; with a receive log (:mod:`flight_sw.rx_log`) every frame read is logged
 with its receive timestamp, flushed per cycle. Status and attitude telemetry go out every
-FSW_STATUS period. Runs until SIGTERM/SIGINT, then writes its statistics file and exits 0.
+FSW_STATUS period. Runs until SIGTERM, SIGINT or SIGHUP, then commands every valve
+closed, writes its statistics file and exits 0.
 """
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import signal
 from pathlib import Path
 from types import FrameType
@@ -114,11 +117,12 @@ class FlightNode:
             if self._waiting:
                 raise StopRequested(signum)
 
-        signal.signal(signal.SIGTERM, _handler)
-        signal.signal(signal.SIGINT, _handler)
+        for s in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
+            signal.signal(s, _handler)
 
     def run(self, mode: str) -> None:
-        """Run ``mode`` ('lockstep' or 'realtime') until stopped; always writes statistics."""
+        """Run ``mode`` ('lockstep' or 'realtime') until stopped; then command every valve
+        closed and write the statistics."""
         try:
             if mode == "lockstep":
                 self.run_lockstep()
@@ -127,7 +131,21 @@ class FlightNode:
         except StopRequested:
             pass
         finally:
+            self._close_valves()
             self.write_stats()
+
+    def _close_valves(self) -> None:
+        """On the way out: one set of valve commands with every on-time 0, for the cycle
+        after the last one (a bench still listening closes its valves; hardware too)."""
+        self._held = None
+        res = self._last_result
+        if res is None:
+            return
+        closed = dataclasses.replace(res, on_time_s=(0.0,) * len(res.on_time_s))
+        with contextlib.suppress(can.CanError, OSError):
+            for name, sig in command_signals(self.icd, self.stats.cycles, closed, self.n_thr,
+                                             self.period_ns):
+                self._send(name, sig)
 
     def _recv(self, timeout_s: float) -> can.Message | None:
         """``bus.recv`` that a stop signal may interrupt (see install_signal_handlers)."""

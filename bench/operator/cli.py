@@ -6,7 +6,9 @@ on the same bus), ``report RUN_DIR`` (redraw plots, print the summary), ``timing
 (per-message timing, chains, bus load, worst-case bounds; ``timing --live --bus SPEC``
 measures a running bus). Exit codes: 0 pass, 1 the run's expectations failed (``timing
 --strict``: a measured latency above its bound, or a message sent but never received), 2
-bad input (scenario, options), 3 run error, 130 interrupted.
+bad input (scenario, options, a bus in use by another run), 3 run error (a process died,
+the disk filled up), 128 + N stopped by signal N (130 SIGINT, 143 SIGTERM, 129 SIGHUP):
+the run folder is complete in every case (bench.operator.lifecycle).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bench.operator.lifecycle import Stopped
 from dbc.errors import BusError, ConfigError, IcdError, RunError
 from transport.spec import BusSpec, default_bus_spec
 
@@ -362,9 +365,14 @@ def main(argv: list[str] | None = None) -> int:
     except RunError as exc:
         print(f"thruster-hil: run error: {exc}", file=sys.stderr)
         return EXIT_RUN_ERROR
+    except Stopped as exc:
+        if exc.summary is not None and exc.out is not None:
+            _print_summary(exc.summary, exc.out)
+        print(f"\nthruster-hil: stopped by {exc.name} (the run folder was completed with "
+              "what ran)", file=sys.stderr)
+        return exc.exit_code
     except KeyboardInterrupt:
-        print("\nthruster-hil: interrupted (the run folder was completed with what ran)",
-              file=sys.stderr)
+        print("\nthruster-hil: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
 
 

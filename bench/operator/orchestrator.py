@@ -35,6 +35,7 @@ from bench.operator.fsw_process import (
     log_tail,
     stop,
 )
+from bench.operator.lifecycle import DiskReserve, Stopped, stop_on_signals, supervise
 from bench.operator.partial import partial_summary, plot_folder
 from bench.operator.run_warnings import (
     bus_warnings,
@@ -56,7 +57,7 @@ from transport.lockstep import available_cpus, lockstep_spin_s
 from transport.spec import mode_options, open_bus
 
 EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH, EXIT_CHILD_BAD_INPUT = 0, 3, 4, 5
-EXIT_CHILD_INTERRUPTED = 6  # Ctrl-C: the run folder is complete, the parent re-raises it
+EXIT_CHILD_STOPPED = 6  # a stop signal: the run folder is complete, the parent re-raises it
 
 
 @dataclass(frozen=True)
@@ -77,14 +78,6 @@ class RunOptions:
         if not self.duration_s >= period_s:  # also rejects NaN
             raise ConfigError("command line", "--duration", self.duration_s,
                               f"at least one control period ({period_s} s)")
-
-
-class Terminated(Exception):  # noqa: N818 - a request, not an error
-    """SIGTERM in the bench process: finish the run folder, then exit."""
-
-
-def _terminate(signum: int, frame: object) -> None:
-    raise Terminated(f"signal {signum}")
 
 
 
@@ -114,37 +107,36 @@ def run_scenario(
         raise ConfigError("command line", "--out", str(out),
                           f"a folder this user can create and write ({exc.strerror or exc})"
                           ) from exc
+    reserve = DiskReserve(out)
     if not hasattr(os, "fork"):  # pragma: no cover - no supervisor where fork is missing
-        return _run_bench(sc, opts, progress, ready, config, spin_s)
+        return _run_bench(sc, opts, progress, ready, config, spin_s, reserve)
     pid = os.fork()
     if pid == 0:  # the bench process
         code = EXIT_CHILD_OK
         try:
             die_with_parent()
-            signal.signal(signal.SIGTERM, _terminate)
+            stop_on_signals()
             (out / "bench.pid").write_text(f"{os.getpid()}\n", encoding="utf-8")
-            _run_bench(sc, opts, progress, ready, config, spin_s)
+            _run_bench(sc, opts, progress, ready, config, spin_s, reserve)
         except ConfigError as exc:
             code = EXIT_CHILD_BAD_INPUT
             if not (out / "summary.json").exists():  # refused before the run: say why
+                reserve.release()
                 partial_summary(sc, opts, f"bad input: {exc}", refused=str(exc))
         except RunError:
             code = EXIT_CHILD_RUN_ERROR
-        except KeyboardInterrupt:
-            code = EXIT_CHILD_INTERRUPTED
-        except BaseException as exc:
+        except (Stopped, KeyboardInterrupt):
+            code = EXIT_CHILD_STOPPED
+        except BaseException:
             code = EXIT_CHILD_CRASH
-            if not (out / "summary.json").exists() and not isinstance(exc, KeyboardInterrupt):
+            if not (out / "summary.json").exists():
                 traceback.print_exc()  # nothing else will say what happened
         finally:
             sys.stdout.flush()
             sys.stderr.flush()
             os._exit(code)
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # the bench handles Ctrl-C itself
-    try:
-        _, status = os.waitpid(pid, 0)
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    status, stop_signal = supervise(pid)
+    reserve.release()
     (out / "bench.pid").unlink(missing_ok=True)  # a pid file names a running process only
     if os.WIFSIGNALED(status):
         summary = partial_summary(sc, opts, f"bench process killed by signal {os.WTERMSIG(status)}")
@@ -155,8 +147,9 @@ def run_scenario(
             "writing summary.json (see its traceback above)")
         raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
-    if os.WEXITSTATUS(status) == EXIT_CHILD_INTERRUPTED:
-        raise KeyboardInterrupt  # after the bench completed the run folder
+    if os.WEXITSTATUS(status) == EXIT_CHILD_STOPPED or stop_signal is not None:
+        # after the bench completed the folder
+        raise Stopped(stop_signal or signal.SIGINT, summary, out)
     if os.WEXITSTATUS(status) == EXIT_CHILD_BAD_INPUT:
         if summary.get("refused"):
             raise RefusedConfigError("the bench", summary["refused"])
@@ -174,6 +167,7 @@ def _run_bench(
     ready: Callable[[Path], None] | None,
     config: Path,
     spin_s: float = 0.0,
+    reserve: DiskReserve | None = None,
 ) -> dict[str, Any]:
     """The bench process: run, then write summary.json and plots (whatever happened).
 
@@ -220,10 +214,15 @@ def _run_bench(
         fsw_rc = stop(proc) if proc is not None else None
         (out / "fsw.pid").unlink(missing_ok=True)
         bus.shutdown()
-    if isinstance(error, (KeyboardInterrupt, Terminated)):
-        node.trace.event(node.plant.t_ns, "run_interrupted",
-                         by="SIGINT" if isinstance(error, KeyboardInterrupt) else str(error))
+    if isinstance(error, KeyboardInterrupt):
+        error = Stopped(signal.SIGINT)
+    if isinstance(error, Stopped):
+        node.trace.event(node.plant.t_ns, "run_interrupted", by=error.name)
+    if reserve is not None:
+        reserve.release()  # the summary and the last of the files get the space kept back
     summary = node.close(opts.duration_s if error is None else node.plant.t_ns / 1e9)
+    summary["ended"] = ("completed" if error is None
+                        else error.name if isinstance(error, Stopped) else "error")
     summary["fsw"] = fsw_report(stats, fsw_rc, out)
     merge_counts(summary["frames"], summary["rejected_other"], "FSW",
                  summary["fsw"].get("sent", {}), summary["fsw"].get("received", {}))

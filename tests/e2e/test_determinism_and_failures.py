@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from bench.operator.cli import EXIT_RUN_ERROR
 from tests.e2e.conftest import QUICKSTART, REPO, run_cli, trace_lines, unique_bus
 
 pytestmark = pytest.mark.slow
@@ -45,7 +46,8 @@ def test_same_seed_gives_identical_trace_other_seed_differs(
 def test_killed_flight_software_closes_valves_and_keeps_run_folder(
     tmp_path: Path, runtime_dir: Path
 ) -> None:
-    """SIGKILL of the flight software: valves closed within 3 periods, run folder complete."""
+    """SIGKILL of the flight software: valves closed within 3 periods, then the run ends as
+    a run error (exit 3) naming the flight software's exit, with a complete run folder."""
     cmd = (
         f"{sys.executable} {REPO / 'tests' / 'e2e' / 'fsw_killed.py'} {KILL_AT_CYCLE} "
         "--bus {bus} --mode {mode} --config {config} --stats {stats}"
@@ -56,6 +58,9 @@ def test_killed_flight_software_closes_valves_and_keeps_run_folder(
         runtime_dir,
     )
     s = r.summary
+    assert r.returncode == EXIT_RUN_ERROR, r.stderr
+    assert "flight software exited during the run" in s["error"] and s["ended"] == "error"
+    assert "flight software exited during the run" in r.stderr
     assert s["valve_watchdog_trips"] == 1
     events = (r.out / "events.jsonl").read_text().splitlines()
     trip = next(e for e in events if '"valve_watchdog"' in e)
@@ -63,7 +68,7 @@ def test_killed_flight_software_closes_valves_and_keeps_run_folder(
     assert ev["t_s"] - ev["last_command_s"] <= (WATCHDOG_PERIODS + 1) * CONTROL_PERIOD_S
     assert ev["t_s"] <= KILL_AT_CYCLE * CONTROL_PERIOD_S + (WATCHDOG_PERIODS + 1) * CONTROL_PERIOD_S
     assert s["deadline_misses"]["stalls"] > 0
-    assert s["fsw"]["exit_code"] == -9
+    assert s["fsw"]["exit_code"] == -9 and s["fsw"]["log_tail"] is not None
     for name in ("trace.asc", "telemetry.csv", "attitude_error.png"):
         assert (r.out / name).stat().st_size > 0
     # after the trip no thruster produces thrust (last telemetry rows)

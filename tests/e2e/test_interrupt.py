@@ -15,6 +15,7 @@ from tests.e2e.conftest import QUICKSTART, running, unique_bus
 pytestmark = pytest.mark.slow
 
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
+SIGNAL_EXIT_BASE = 128
 INTERRUPT_AT_PERCENT = 10.0
 
 
@@ -29,9 +30,9 @@ def test_ctrl_c_exits_130_with_a_complete_folder(
         os.killpg(p.pid, signal.SIGINT)
         _, err = p.communicate()
     assert p.returncode == EXIT_INTERRUPTED, err
-    assert "interrupted" in err and "Traceback" not in err
+    assert "stopped by SIGINT" in err and "Traceback" not in err
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
-    assert 0.0 < summary["sim_time_s"] < 20.0
+    assert 0.0 < summary["sim_time_s"] < 20.0 and summary["ended"] == "SIGINT"
     events = [json.loads(x) for x in (out / "events.jsonl").read_text().splitlines()]
     assert any(e["event"] == "run_interrupted" for e in events)
     assert "Traceback" not in (out / "fsw.log").read_text(encoding="utf-8")
@@ -39,3 +40,23 @@ def test_ctrl_c_exits_130_with_a_complete_folder(
     with can.LogReader(str(out / "trace.asc")) as reader:
         assert sum(1 for _ in reader) > 0
     assert all((out / f).exists() for f in ("telemetry.csv", "attitude_error.png"))
+
+
+@pytest.mark.parametrize("mode", ["lockstep", "realtime"])
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_and_sighup_leave_a_valid_summary_and_no_leftovers(
+    tmp_path: Path, runtime_dir: Path, mode: str, sig: signal.Signals
+) -> None:
+    """SIGTERM or SIGHUP to the process group (a CI runner, timeout, a closed terminal):
+    exit 128 + N, summary.json says how the run ended, no pid file, no bus socket left."""
+    out = tmp_path / "run"
+    args = ["run", str(QUICKSTART), "--bus", unique_bus(), "--mode", mode, "--duration", "20"]
+    with running(args, out, runtime_dir, INTERRUPT_AT_PERCENT, own_group=True) as p:
+        os.killpg(p.pid, sig)
+        _, err = p.communicate()
+    assert p.returncode == SIGNAL_EXIT_BASE + sig, err
+    assert f"stopped by {sig.name}" in err and "Traceback" not in err
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert summary["ended"] == sig.name and 0.0 < summary["sim_time_s"] < 20.0
+    assert not list(out.glob("*.pid")) and not list(out.glob(".space-*"))
+    assert not [f for f in runtime_dir.rglob("*") if f.is_socket()]
