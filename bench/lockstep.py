@@ -103,7 +103,9 @@ class Lockstep:
             msg = recv_spinning(n.bus, left_s, n.lockstep_spin_s)
             if msg is None:
                 break
-            for a in n.receipt.receive(msg, n.clock.now_ns(), k):
+            arrivals = n.receipt.receive(msg, n.clock.now_ns(), k)
+            n.note_rejects(arrivals, events)
+            for a in arrivals:
                 is_cmd = a.name is not None and n.receipt.command_index(a.name) is not None
                 if a.fate.drop:
                     lost += is_cmd

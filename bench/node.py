@@ -38,7 +38,7 @@ from bench.scenario.spec import Scenario
 from bench.station.fault_book import Event
 from bench.station.plant import STEP_NS
 from bench.station.station import WATCHDOG_PERIODS, Station
-from bench.wire.receipt import Receipt
+from bench.wire.receipt import Arrival, Receipt
 from bench.wire.timing.arbiter import bus_off_recovery_ns
 from bench.wire.trace import TraceRecorder
 from bench.wire.wire import Wire
@@ -46,6 +46,7 @@ from dbc.codec import Decoded, Encoder, FrameChecker
 from dbc.errors import RunError
 from dbc.icd import BENCH, FSW, Icd
 
+NON_ICD = "non-ICD frames"  # unknown and extended IDs, error frames, in reject events
 FAULT_RNG_STREAM = 0xFA  # spawn key of the wire's fault-injection random stream
 STARTUP_POLL_S = 0.2
 NS_PER_S = 1_000_000_000
@@ -109,6 +110,7 @@ class BenchNode:
         self.lockstep_spin_s = 0.0  # poll this long before blocking (transport.lockstep)
         self.fsw_alive: Callable[[], bool] | None = None
         self.fsw_exit_ns: int | None = None  # when the flight-software process was found gone
+        self._rejects_seen: set[tuple[str, str]] = set()
         self.started = False  # the run has begun (live fault commands are taken)
         self.last_sync_ns = 0  # lockstep: time of the run's last SYNC
         self._samples: list[tuple[str, dict[str, float | int]]] = []
@@ -221,6 +223,19 @@ class BenchNode:
             raise RunError(f"the flight software exited during the run (found gone at "
                            f"{self.fsw_exit_ns / NS_PER_S:g} s of simulated time); {closed}")
 
+    def note_rejects(self, arrivals: list[Arrival], events: list[Event]) -> None:
+        """The first reject of each message and cause from another node is an event (the
+        console names it as it starts); later ones are only counted."""
+        for a in arrivals:
+            if a.cause is None:
+                continue
+            name = a.name if a.name is not None else NON_ICD
+            key = (name, a.cause.value)
+            if key not in self._rejects_seen and self.icd.sender.get(name) != BENCH:
+                self._rejects_seen.add(key)
+                events.append((self.station.t_ns, "frames_rejected",
+                               {"message": name, "cause": a.cause.value}))
+
     def _second_sender(self) -> None:
         """Evidence of a second sender raises BENCH_STATUS.Health's flag (once)."""
         if self.receipt.second_sender and not self.station.second_sender:
@@ -247,7 +262,11 @@ class BenchNode:
             msg = self.bus.recv(timeout=min(STARTUP_POLL_S, left_s))
             if msg is None:
                 continue
-            for a in self.receipt.receive(msg, clock.now_ns(), None):
+            arrivals = self.receipt.receive(msg, clock.now_ns(), None)
+            rejects: list[Event] = []
+            self.note_rejects(arrivals, rejects)
+            self._events(rejects)
+            for a in arrivals:
                 # bits 0: before the run, off the modelled wire (the timing analysis skips it)
                 self.trace.frame(a.msg, 0, tx=False,
                                  t_rx_ns=0 if a.decoded is not None else float("nan"))

@@ -86,7 +86,9 @@ class Realtime:
         n, clock = self.node, self.clock
         st = n.station
         events: list[Event] = []
-        for a in n.receipt.receive(msg, clock.now_ns(), None):
+        arrivals = n.receipt.receive(msg, clock.now_ns(), None)
+        n.note_rejects(arrivals, events)
+        for a in arrivals:
             if a.fate.drop:
                 continue
             t_ns = clock.now_ns()

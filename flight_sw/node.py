@@ -142,10 +142,10 @@ class FlightNode:
         if res is None:
             return
         closed = dataclasses.replace(res, on_time_s=(0.0,) * len(res.on_time_s))
-        with contextlib.suppress(can.CanError, OSError):
+        with contextlib.suppress(can.CanError, OSError):  # after the run: not in ``sent``
             for name, sig in command_signals(self.icd, self.stats.cycles, closed, self.n_thr,
                                              self.period_ns):
-                self._send(name, sig)
+                self.bus.send(self.encoder.message(name, sig))
 
     def _recv(self, timeout_s: float) -> can.Message | None:
         """``bus.recv`` that a stop signal may interrupt (see install_signal_handlers)."""

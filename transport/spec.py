@@ -24,6 +24,7 @@ the spec.
 from __future__ import annotations
 
 import errno
+import secrets
 import socket
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,6 +37,8 @@ from dbc.errors import BusError, BusInitError
 DEFAULT_SOCKETCAN_CHANNEL = "vcan0"
 PORTABLE_INTERFACE = "hilbus"
 PORTABLE_DEFAULT_CHANNEL = "default"
+PRIVATE_CHANNEL_PREFIX = "run-"  # a run's own channel when no bus is named
+PRIVATE_TOKEN_BYTES = 4
 # Realtime on the portable bus: a member whose queue stays full this long (a paused bus
 # monitor) loses frames instead of holding the sender; half a 20 ms control period, below
 # the flight software's IMU loss (3 x 10 ms) and the valve watchdog (3 x 20 ms). A real
@@ -112,6 +115,11 @@ def default_bus_spec(sys_net: Path = SYS_NET) -> str:
     if (sys_net / DEFAULT_SOCKETCAN_CHANNEL).exists():
         return f"socketcan:{DEFAULT_SOCKETCAN_CHANNEL}"
     return f"{PORTABLE_INTERFACE}:{PORTABLE_DEFAULT_CHANNEL}"
+
+
+def private_bus_spec() -> str:
+    """A portable-bus channel no other run uses: ``hilbus:run-<8 hex digits>``."""
+    return f"{PORTABLE_INTERFACE}:{PRIVATE_CHANNEL_PREFIX}{secrets.token_hex(PRIVATE_TOKEN_BYTES)}"
 
 
 def open_bus(spec: str | BusSpec, **kwargs: object) -> can.BusABC:

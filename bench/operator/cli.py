@@ -14,15 +14,15 @@ the run folder is complete in every case (bench.operator.lifecycle).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
 from bench.operator.lifecycle import Stopped
 from dbc.errors import BusError, ConfigError, IcdError, RunError
-from transport.spec import BusSpec, default_bus_spec
+from transport.spec import BusSpec, default_bus_spec, private_bus_spec
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
@@ -89,29 +89,35 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
     print("\n".join(lines))
 
 
-def _default_out(name: str) -> Path:
-    return Path("runs") / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
-
-
 def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
+    from bench.operator import alerts
     from bench.operator.fsw_process import DEFAULT_FSW_CMD
     from bench.operator.orchestrator import RunOptions, run_scenario
+    from bench.operator.run_folder import default_run_folder, prepare_run_folder
     from bench.operator.run_warnings import scenario_warnings
     from bench.scenario.load import load_scenario
 
     sc = load_scenario(args.scenario, args.overrides)
     for w in scenario_warnings(sc):  # said before the run too, not only in its summary
         print(f"thruster-hil: warning: {w}", file=sys.stderr)
-    bus = args.bus or default_bus_spec()
-    BusSpec.parse(bus)
-    opts = RunOptions(
+    bus = args.bus or private_bus_spec()
+    spec = BusSpec.parse(bus)
+    if args.bus is None or args.out is None:
+        where = "" if args.bus is not None else (
+            f" (a channel of its own; watch it: python -m can.logger -i {spec.interface} "
+            f"-c {spec.channel})")
+        print(f"thruster-hil: bus {bus}{where}", file=sys.stderr, flush=True)
+    opts = RunOptions(  # checks the options before any folder is made
         mode=args.mode,
         bus=bus,
         seed=sc.seed if args.seed is None else args.seed,
-        out=Path(args.out) if args.out else _default_out(sc.name),
+        out=Path(args.out or "."),
         duration_s=args.duration if args.duration is not None else sc.duration_s,
         fsw_cmd=None if alone else (args.fsw_cmd or DEFAULT_FSW_CMD),
+        bus_shared=args.bus is not None,
     )
+    opts = dataclasses.replace(opts, out=prepare_run_folder(Path(args.out), args.replace)
+                               if args.out else default_run_folder(sc.name))
 
     def ready(config: Path) -> None:
         print(
@@ -123,7 +129,8 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
             flush=True,
         )
 
-    summary = run_scenario(sc, opts, _progress_printer(), ready if alone else None)
+    summary = run_scenario(sc, opts, _progress_printer(), ready if alone else None,
+                           alerts.printer())
     if sys.stderr.isatty():
         sys.stderr.write("\n")
     _print_summary(summary, opts.out)
@@ -208,11 +215,15 @@ def build_parser() -> argparse.ArgumentParser:
         r.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
         r.add_argument(
             "--bus",
-            help="bus spec INTERFACE:CHANNEL (default: socketcan:vcan0 if "
-            "present, else hilbus:default)",
+            help="bus spec INTERFACE:CHANNEL, e.g. socketcan:vcan0 or hilbus:lab (default: "
+            "a portable-bus channel of this run's own, printed at the start; on a named bus "
+            "another run is detected and refused)",
         )
         r.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
-        r.add_argument("--out", help="run folder (default: runs/<scenario>-<time>)")
+        r.add_argument("--out", help="run folder, new or empty (default: "
+                       "runs/<scenario>-<time>-<hex>, a new folder)")
+        r.add_argument("--replace", action="store_true",
+                       help="let --out name a folder holding an earlier run, which is deleted")
         r.add_argument("--duration", type=float, help="override the scenario duration [s]")
         r.add_argument("--set", dest="overrides", action="append", default=[],
                        metavar="KEY=VALUE",

@@ -44,6 +44,7 @@ from bench.operator.run_warnings import (
     overrun_warning,
     scenario_warnings,
 )
+from bench.operator.shared_bus import probe
 from bench.results.counts import merge_counts, zero_unheard
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
@@ -70,6 +71,7 @@ class RunOptions:
     out: Path
     duration_s: float
     fsw_cmd: str | None = DEFAULT_FSW_CMD  # None: bench alone (external flight software)
+    bus_shared: bool = False  # a bus the user named: another run may be on it (probed)
 
     def __post_init__(self) -> None:
         if self.mode not in ("lockstep", "realtime"):
@@ -86,8 +88,11 @@ def run_scenario(
     opts: RunOptions,
     progress: Callable[[float, float], None] | None = None,
     ready: Callable[[Path], None] | None = None,
+    alert: Callable[[int, str, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
     """Run ``sc``; returns the summary (also written to ``opts.out/summary.json``).
+
+    ``alert`` hears every event of the run as it happens (bench.operator.alerts).
 
     The bench runs in a forked child process and this process supervises it, so that the
     run folder is completed (from the files written so far) even if the bench is killed.
@@ -97,6 +102,13 @@ def run_scenario(
         # a bad placeholder: exit 2 before anything runs
         fsw_argv(opts.fsw_cmd, opts.bus, opts.mode, out, out, out)
     check_bus(opts.bus)
+    if opts.bus_shared:
+        heard = probe(opts.bus)
+        if heard:
+            raise ConfigError("command line", "--bus", opts.bus,
+                              f"a bus no other run uses (heard {', '.join(heard)} from a "
+                              "running bench or flight software; leave out --bus for a "
+                              "channel of this run's own)")
     spin_s = lockstep_spin_s(available_cpus(), os.environ) if opts.mode == "lockstep" else 0.0
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -109,7 +121,7 @@ def run_scenario(
                           ) from exc
     reserve = DiskReserve(out)
     if not hasattr(os, "fork"):  # pragma: no cover - no supervisor where fork is missing
-        return _run_bench(sc, opts, progress, ready, config, spin_s, reserve)
+        return _run_bench(sc, opts, progress, ready, config, spin_s, reserve, alert)
     pid = os.fork()
     if pid == 0:  # the bench process
         code = EXIT_CHILD_OK
@@ -117,7 +129,7 @@ def run_scenario(
             die_with_parent()
             stop_on_signals()
             (out / "bench.pid").write_text(f"{os.getpid()}\n", encoding="utf-8")
-            _run_bench(sc, opts, progress, ready, config, spin_s, reserve)
+            _run_bench(sc, opts, progress, ready, config, spin_s, reserve, alert)
         except ConfigError as exc:
             code = EXIT_CHILD_BAD_INPUT
             if not (out / "summary.json").exists():  # refused before the run: say why
@@ -168,6 +180,7 @@ def _run_bench(
     config: Path,
     spin_s: float = 0.0,
     reserve: DiskReserve | None = None,
+    alert: Callable[[int, str, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
     """The bench process: run, then write summary.json and plots (whatever happened).
 
@@ -180,6 +193,7 @@ def _run_bench(
     bus = open_bus(opts.bus, **mode_options(opts.bus, opts.mode))
     proc: subprocess.Popen[bytes] | None = None
     node = BenchNode(sc, db, bus, out, opts.mode, opts.seed, opts.bus, progress)
+    node.trace.listener = alert
     node.lockstep_spin_s = spin_s
     if ready is not None:
         ready(config)

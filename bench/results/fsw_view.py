@@ -40,6 +40,7 @@ class FswView:
         self.icd = icd
         self._boot = icd.modes["BOOT"]
         self._no_thruster = icd.no_failed_thruster
+        self._mode_names = {v: k for k, v in icd.modes.items()}
         self.status: dict[str, float] = {}
         self.q_est: tuple[float, float, float, float] | None = None
         self.q_valid = False
@@ -67,10 +68,17 @@ class FswView:
 
     def on_status(self, signals: dict[str, float], t_ns: int, events: list[Event]) -> None:
         """Take an FSW_STATUS (a restart already accepted by :meth:`restart_allowed`)."""
-        if int(signals["Mode"]) == self._boot and self.status.get("Mode", self._boot) != self._boot:
+        mode, previous = int(signals["Mode"]), self.status.get("Mode")
+        if mode == self._boot and previous is not None and previous != self._boot:
             # the flight software booted again: its counters restart, its state is new
             self.restarts += 1
             events.append((t_ns, "fsw_restart", {"count": self.restarts}))
+        elif previous is not None and mode != int(previous):
+            flags = int(signals["FdirFlags"])
+            events.append((t_ns, "fsw_mode", {
+                "mode": self._mode_names.get(mode, str(mode)),
+                "previous": self._mode_names.get(int(previous), str(previous)),
+                "fdir_flags": [n for n, bit in self.icd.fdir_flags.items() if flags & bit]}))
         self.status = signals
 
     def refuse_restart(self, t_ns: int, events: list[Event]) -> None:

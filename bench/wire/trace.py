@@ -24,6 +24,7 @@ No clock is read here: every timestamp is passed in (the trace's start date too)
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from datetime import datetime
 from pathlib import Path
 from typing import IO, Any
@@ -66,6 +67,8 @@ class TraceRecorder:
         self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
         self._frames = TelemetryWriter(run_dir / "frames.csv", FRAME_COLUMNS, deferred)
         self.frames_written = 0
+        #: called with (t_ns, event, fields) for every event (bench.operator.alerts)
+        self.listener: Callable[[int, str, dict[str, Any]], None] | None = None
 
     def frame(
         self, msg: can.Message, t_ns: int, tx: bool, *, t_ready_ns: float = NAN,
@@ -116,9 +119,12 @@ class TraceRecorder:
             can.Message(timestamp=t_ns / NS_PER_S, is_error_frame=True, channel=0))
 
     def event(self, t_ns: int, what: str, /, **fields: Any) -> None:
-        """Append one event line (``what`` at ``t_ns`` with ``fields``) and flush it."""
+        """Append one event line (``what`` at ``t_ns`` with ``fields``) and flush it; the
+        :attr:`listener`, if set, hears it too (the console's live alerts)."""
         self._events.write(json.dumps({"event": what, **fields, "t_s": t_ns / NS_PER_S}) + "\n")
         self._events.flush()
+        if self.listener is not None:
+            self.listener(t_ns, what, fields)
         if what in TRACE_EVENTS:  # also in the CAN trace, as an ASC event line
             text = " ".join(f"{k}={v}" for k, v in fields.items() if k != "t_s")
             line = f"thruster-hil {what} {text}".rstrip()
