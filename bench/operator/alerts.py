@@ -57,9 +57,10 @@ def _fields_text(fields: Fields) -> str:
     return ", ".join(f"{k}={v}" for k, v in fields.items() if k not in ("kind", "source"))
 
 
-def printer(stream: TextIO = sys.stderr) -> Callable[[int, str, Fields], None]:
-    """A listener that prints each alert as one line (after a newline if a progress bar is
-    being drawn on a terminal)."""
+def printer(stream: TextIO | None = None) -> Callable[[int, str, Fields], None]:
+    """A listener that prints each alert as one line to ``stream`` (default: the process's
+    stderr at the time), after a newline if a progress bar is drawn on a terminal."""
+    stream = stream if stream is not None else sys.stderr
     tty = stream.isatty()
 
     def alert(t_ns: int, what: str, fields: Fields) -> None:
