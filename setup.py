@@ -17,7 +17,13 @@ What and why
 Pure-Python install
     ``THRUSTER_HIL_PURE=1 pip install -e .`` builds nothing: every module runs from its
     source, with the same results, only slower. Also the way to develop one of these
-    modules without rebuilding after each edit.
+    modules without rebuilding after each edit. Python prefers an extension beside a
+    ``.py`` of the same name, so a pure install first removes the extensions an earlier
+    compiled install left in the source tree (each module of :data:`COMPILED` and the
+    packages' shared ``compiled__mypyc`` libraries) and names each one on stderr (pip
+    shows it with ``-v``); otherwise every edit of those modules would be silently
+    ignored. ``tests/test_compiled.py`` skips its freshness checks when no module of
+    :data:`COMPILED` has an extension.
 
 Rules for a compiled module (what differs from the interpreter, each met in this code)
     - A frozen configuration dataclass that validates its own fields is marked
@@ -40,7 +46,10 @@ Editing a compiled module
 
 from __future__ import annotations
 
+import importlib.machinery
 import os
+import sys
+from pathlib import Path
 
 from setuptools import setup
 
@@ -95,10 +104,36 @@ COMPILED = [
 ]
 PURE_ENV = "THRUSTER_HIL_PURE"
 PACKAGES = ("bench", "dbc", "flight_sw")
+SHARED_LIBRARY = "compiled__mypyc"  # mypyc's library of a group, one per package
+
+
+def stale_extensions(root: Path) -> list[Path]:
+    """The compiled modules of :data:`COMPILED` and the groups' shared libraries found
+    in the source tree at ``root`` (what a compiled install left beside the sources)."""
+    found: list[Path] = []
+    stems = [Path(p).with_suffix("") for p in COMPILED]
+    stems += [Path(pkg) / SHARED_LIBRARY for pkg in PACKAGES]
+    for stem in stems:
+        folder = root / stem.parent
+        if folder.is_dir():
+            found += sorted(p for p in folder.iterdir() if p.name.startswith(stem.name + ".")
+                            and p.name.endswith(tuple(importlib.machinery.EXTENSION_SUFFIXES)))
+    return found
+
+
+def remove_stale_extensions(root: Path) -> list[Path]:
+    """Remove :func:`stale_extensions` under ``root``, saying so on stderr; returns them."""
+    removed = stale_extensions(root)
+    for path in removed:
+        path.unlink()
+        print(f"thruster-hil pure install: removed {path.relative_to(root)} (a compiled "
+              "module of an earlier install would shadow its source)", file=sys.stderr)
+    return removed
 
 
 def _ext_modules() -> list:
     if os.environ.get(PURE_ENV) == "1":
+        remove_stale_extensions(Path(__file__).resolve().parent)
         return []
     from mypyc.build import mypycify
 

@@ -18,7 +18,9 @@ catches hilbus's failures with ``except can.CanError`` (or the specific class), 
 project's command-line tools catch ``BusError`` and exit 2 naming the bus. python-can asks
 for ValueError where a constructor argument is out of range, hence BusArgumentError.
 Messages carry the cause and the bus or path concerned; python-can's ``error_code`` is
-None.
+None. A value is shown by :func:`brief`: its ``repr`` when that is short, else its type,
+its length and a short prefix (a 5-million-element array or a 100 000-deep nesting makes a
+one-line message, not megabytes or a RecursionError).
 
 Frame-level problems on receipt are *not* exceptions: they are counted by cause
 (see :mod:`dbc.codec`), because a bad frame must never crash a receiver.
@@ -26,7 +28,59 @@ Frame-level problems on receipt are *not* exceptions: they are counted by cause
 
 from __future__ import annotations
 
+import reprlib
+
 import can
+
+# Longest value text in a message: a short repr is shown whole, a longer one is cut.
+BRIEF_CHARS = 80
+BRIEF_ITEMS = 6  # items of a container shown before "..."
+BRIEF_LEVELS = 3  # nesting levels shown before "..."
+_ELLIPSIS = "..."
+
+
+def _brief_repr() -> reprlib.Repr:
+    """A reprlib that cuts every container, string and number to a few characters."""
+    r = reprlib.Repr()
+    r.maxlevel = BRIEF_LEVELS
+    r.maxtuple = r.maxlist = r.maxarray = r.maxdict = BRIEF_ITEMS
+    r.maxset = r.maxfrozenset = r.maxdeque = BRIEF_ITEMS
+    r.maxstring = r.maxother = BRIEF_CHARS
+    r.maxlong = BRIEF_CHARS
+    return r
+
+
+_BRIEF = _brief_repr()
+
+
+def brief(value: object) -> str:
+    """``repr(value)`` for messages, at most about :data:`BRIEF_CHARS` characters.
+
+    A value whose repr would be longer (or nested deeper than :data:`BRIEF_LEVELS`) is
+    shown as its type, its length where it has one, and a cut repr:
+    ``list of 5000000 items: [0, 0, 0, 0, 0, 0, ...]``. Never raises, never recurses
+    deeper than :data:`BRIEF_LEVELS`, and never builds the whole repr of a large value.
+    """
+    try:
+        if isinstance(value, int) and not isinstance(value, bool):
+            digits = value.bit_length() * 0.30103  # log10(2): decimal digits, roughly
+            if digits > BRIEF_CHARS:
+                return f"int of about {int(digits) + 1} digits"
+        text = _BRIEF.repr(value)
+    except Exception:  # a value whose repr fails is still named by its type
+        return f"<{type(value).__name__}>"
+    cut = len(value) > BRIEF_CHARS if isinstance(value, (str, bytes)) else _ELLIPSIS in text
+    if len(text) > BRIEF_CHARS:
+        text, cut = text[:BRIEF_CHARS] + _ELLIPSIS, True
+    if not cut:
+        return text
+    kind = type(value).__name__
+    try:
+        size = len(value)  # type: ignore[arg-type]
+    except TypeError:
+        return f"{kind}: {text}"
+    unit = "char" if isinstance(value, (str, bytes)) else "item"
+    return f"{kind} of {size} {unit}{'' if size == 1 else 's'}: {text}"
 
 
 class ThrusterHilError(Exception):
@@ -41,7 +95,7 @@ class ConfigError(ThrusterHilError, ValueError):
         self.key = key
         self.value = value
         self.expected = expected
-        super().__init__(f"{source}: {key} = {value!r}: expected {expected}")
+        super().__init__(f"{source}: {key} = {brief(value)}: expected {expected}")
 
 
 class RefusedConfigError(ConfigError):

@@ -21,6 +21,10 @@ from dbc.errors import ConfigError
 _MISSING = object()
 MATRIX3_ROWS = 3
 NEAR_MISS_CUTOFF = 0.75  # difflib similarity above which a present key is suggested
+# The integers of a configuration table are counts (samples, cycles), indices, IDs and
+# versions: at most this unless the key says otherwise (ten million 20 ms cycles: 55 h;
+# a bitrate in bit/s reaches 1e6), so a count of 10**12 is refused, not allocated.
+MAX_TABLE_INTEGER = 10**7
 
 
 class Table:
@@ -75,9 +79,10 @@ class Table:
         v = self.raw(key, default)
         return check.number(self._source, self._key(key), v, _lo(lo), _hi(hi), lo_open=lo_open)
 
-    def integer(self, key: str, default: Any = _MISSING, *, lo: int | None = None) -> int:
-        """An integer >= lo."""
-        return check.integer(self._source, self._key(key), self.raw(key, default), lo)
+    def integer(self, key: str, default: Any = _MISSING, *, lo: int | None = None,
+                hi: int = MAX_TABLE_INTEGER) -> int:
+        """An integer in [lo, hi] (``hi``: :data:`MAX_TABLE_INTEGER` unless given)."""
+        return check.integer(self._source, self._key(key), self.raw(key, default), lo, hi)
 
     def flag(self, key: str, default: Any = _MISSING) -> bool:
         """A bool (``true`` or ``false``)."""

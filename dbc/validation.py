@@ -128,13 +128,23 @@ def limit(source: str, key: str, value: object, unit: str = "") -> float:
     return number(source, key, value, 0.0, lo_open=True, allow_inf=True, unit=unit)
 
 
-def integer(source: str, key: str, value: object, lo: int | None = None) -> int:
-    """An int (not a bool), at least ``lo`` when given."""
+def integer(source: str, key: str, value: object, lo: int | None = None,
+            hi: int | None = None) -> int:
+    """An int (not a bool), at least ``lo`` and at most ``hi`` when given."""
     ok = isinstance(value, numbers.Integral) and not isinstance(value, bool)
-    if not ok or (lo is not None and int(value) < lo):  # type: ignore[call-overload]
-        raise ConfigError(source, key, value,
-                          "an integer" if lo is None else f"an integer >= {lo}")
-    return int(value)  # type: ignore[call-overload]
+    n = int(value) if ok else 0  # type: ignore[call-overload]
+    if not ok or (lo is not None and n < lo) or (hi is not None and n > hi):
+        raise ConfigError(source, key, value, integer_range(lo, hi))
+    return n
+
+
+def integer_range(lo: int | None, hi: int | None) -> str:
+    """``expected`` of :func:`integer` in words: ``an integer in [0, 10]``, ``>= 1``."""
+    if lo is not None and hi is not None:
+        return f"an integer in [{lo}, {hi}]"
+    if lo is not None:
+        return f"an integer >= {lo}"
+    return "an integer" if hi is None else f"an integer <= {hi}"
 
 
 def flag(source: str, key: str, value: object) -> bool:

@@ -10,23 +10,26 @@ file).
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import gc
 import os
 import sys
 from pathlib import Path
 
+from dbc import options as opt
 from dbc.codec import cycle_time_ns
 from dbc.contract import EXIT_REFUSED, FswRefusal
 from dbc.database import load_database
 from dbc.errors import BusError, ConfigError
+from dbc.options import StrictParser
 from dbc.records import write_record
 from flight_sw.config import build_computer, load_config
 from flight_sw.node import FlightNode
 from flight_sw.rx_log import ReceiveLog
 from transport.lockstep import available_cpus, lockstep_spin_s
-from transport.spec import default_bus_spec, mode_options, open_bus
+from transport.spec import check_bus_spec, default_bus_spec, mode_options, open_bus
+
+MODES = ("lockstep", "realtime")
 
 
 def _write_refusal(stats: str | None, refusal: FswRefusal) -> None:
@@ -36,24 +39,44 @@ def _write_refusal(stats: str | None, refusal: FswRefusal) -> None:
             write_record(Path(stats), refusal.to_json())
 
 
+def _check_writable(option: str, path: Path) -> None:
+    """ConfigError unless ``path`` can be written: not a folder, in a writable folder."""
+    folder = path.parent
+    if path.is_dir() or not folder.is_dir() or not os.access(folder, os.W_OK | os.X_OK):
+        raise ConfigError("command line", option, str(path),
+                          "a file path in an existing folder this user can write")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the flight software."""
-    p = argparse.ArgumentParser(prog="thruster-hil-fsw", description=__doc__.split("\n")[0])
-    p.add_argument("--config", required=True, help="flight-software configuration JSON")
+    p = StrictParser(prog="thruster-hil-fsw", description=__doc__.split("\n")[0],
+                     error_prefix="flight_sw")
+    p.add_argument("--config", required=True, type=opt.text("--config", "a file path"),
+                   help="flight-software configuration JSON (thruster-hil/fsw-config)")
     p.add_argument(
-        "--bus", help="bus spec (default: socketcan:vcan0 if present, else hilbus:default)"
+        "--bus", type=opt.checked("--bus", check_bus_spec),
+        help="bus spec (default: socketcan:vcan0 if present, else hilbus:default); an "
+        "interface other processes share",
     )
-    p.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
-    p.add_argument("--stats", help="write frame and cycle statistics JSON here")
+    p.add_argument("--mode", type=opt.choice("--mode", MODES), default="lockstep",
+                   metavar="{lockstep,realtime}",
+                   help="lockstep: one cycle per SYNC from the bench; realtime: its own "
+                   "timer (default lockstep)")
+    p.add_argument("--stats", type=opt.text("--stats", "a file path"),
+                   help="write frame and cycle statistics JSON here (its folder must exist)")
     p.add_argument(
-        "--rx-log",
+        "--rx-log", type=opt.text("--rx-log", "a file path"),
         help="realtime: log every received frame's receive timestamp, ID and alive counter "
         "to this CSV file (the bench's timing analysis turns it into bench-frame latency)",
     )
     p.add_argument("--check", action="store_true", help="validate the configuration and exit")
-    args = p.parse_args(argv)
+    args = opt.parse_or_exit_code(p, argv)
+    if isinstance(args, int):
+        return args
     db = load_database()
     try:
+        if args.stats:
+            _check_writable("--stats", Path(args.stats))
         computer = build_computer(
             load_config(args.config),
             cycle_time_ns(db, "THR_CMD_0"),

@@ -26,7 +26,6 @@ Optional tables of ``flight_sw`` (issue 4):
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
@@ -34,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from dbc.contract import FswConfig
+from dbc.datafile import parse_json, read_text
 from dbc.errors import ConfigError
 from dbc.schema import Table
 from flight_sw.allocation.authority import authority_warnings
@@ -241,16 +241,9 @@ def build_computer(
 
 
 def load_config(path: str | Path) -> dict[str, Any]:
-    """Read the configuration JSON at ``path``."""
+    """Read the configuration JSON at ``path`` (size, encoding, nesting: :mod:`dbc.datafile`)."""
     p = Path(path)
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise ConfigError(
-            str(p), "<file>", str(p), f"a readable configuration file ({exc.strerror})"
-        ) from exc
-    except json.JSONDecodeError as exc:
-        raise ConfigError(str(p), "<syntax>", str(exc), "valid JSON") from exc
+    data = parse_json(read_text(p, "configuration file"), str(p))
     if not isinstance(data, dict):
         raise ConfigError(str(p), "<root>", type(data).__name__, "a JSON object")
     return data

@@ -3,8 +3,11 @@
 Each compiled module is checked against its own source, loaded a second time as plain
 interpreted Python under another name: the same inputs give exactly equal outputs (RK4
 states, thruster wrenches, CAN frame lengths, CRCs, dual-quaternion products, PWPF
-on-times). Random inputs come from a fixed seed. With ``THRUSTER_HIL_PURE=1`` nothing is
-compiled and the freshness checks are skipped; the comparisons then hold trivially.
+on-times). Random inputs come from a fixed seed. In a pure-Python install (``THRUSTER_HIL_PURE=1``
+in the environment, or no module of COMPILED with an extension on disk: what
+``THRUSTER_HIL_PURE=1 pip install -e .`` leaves, since it removes stale ones) nothing is
+compiled and the freshness checks are skipped; the comparisons then hold trivially. Some
+modules compiled and others not is a broken build and fails.
 """
 
 from __future__ import annotations
@@ -44,6 +47,28 @@ def _module_name(path: str) -> str:
     return path.removesuffix(".py").replace("/", ".")
 
 
+def _found_origin(path: str) -> Path | None:
+    """What the import system finds on disk for the module at ``path`` (not sys.modules: a
+    module imported by another compiled one has a synthetic __spec__ and __file__)."""
+    source = REPO / path
+    spec = importlib.machinery.PathFinder.find_spec(_module_name(path), [str(source.parent)])
+    return None if spec is None or spec.origin is None else Path(spec.origin)
+
+
+def _is_extension(origin: Path | None) -> bool:
+    return origin is not None and origin.name.endswith(
+        tuple(importlib.machinery.EXTENSION_SUFFIXES))
+
+
+# a pure install: said so, or not one listed module has an extension
+PURE_REASON = (
+    "THRUSTER_HIL_PURE=1: a pure-Python install" if PURE
+    else None if any(_is_extension(_found_origin(p)) for p in COMPILED)
+    else "a pure-Python install: no module of setup.py's COMPILED has a compiled extension "
+    "(`pip install -e .` without THRUSTER_HIL_PURE=1 builds them)"
+)
+
+
 def _source_twin(name: str) -> ModuleType:
     """The module ``name`` interpreted from its ``.py`` (dependencies as installed)."""
     path = REPO / (name.replace(".", "/") + ".py")
@@ -58,15 +83,13 @@ def _source_twin(name: str) -> ModuleType:
 @pytest.mark.parametrize("path", COMPILED)
 def test_compiled_module_is_built_and_fresh(path: str) -> None:
     """Each listed module imports as an extension no older than its source."""
-    if PURE:
-        pytest.skip("THRUSTER_HIL_PURE=1: a pure-Python install")
+    if PURE_REASON is not None:
+        pytest.skip(PURE_REASON)
     source = REPO / path
-    # what the import system finds on disk (not sys.modules: a module imported by another
-    # compiled one has a synthetic __spec__ and __file__)
-    spec = importlib.machinery.PathFinder.find_spec(_module_name(path), [str(source.parent)])
-    assert spec is not None and spec.origin is not None
-    built = Path(spec.origin)
-    assert built.suffix == ".so", f"{path}: not compiled ({built}); run `pip install -e .`"
+    built = _found_origin(path)
+    assert built is not None, f"{path}: not importable"
+    assert _is_extension(built), (
+        f"{path}: not compiled ({built}) while other modules are; run `pip install -e .`")
     assert built.stat().st_mtime >= source.stat().st_mtime, (
         f"{path} changed after {built.name} was built: rerun `pip install -e .`"
     )

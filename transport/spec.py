@@ -18,7 +18,12 @@ lose frames. ``SO_RCVBUFFORCE`` is used where the process may (CAP_NET_ADMIN), e
 
 Errors: a malformed spec raises :class:`~dbc.errors.BusError`; a bus that cannot be opened
 raises :class:`~dbc.errors.BusInitError` (a :class:`can.CanInitializationError`); both name
-the spec.
+the spec. :func:`check_bus_spec` is the command lines' check before anything starts: a
+malformed spec, an interface python-can does not have (``can.interfaces.VALID_INTERFACES``,
+plugins such as ``hilbus`` included) or one whose bus exists inside one process only
+(python-can's ``virtual``: the bench, the flight software and the tools are separate
+processes, so nothing would ever be heard on it) is a
+:class:`~dbc.errors.ConfigError` naming the option.
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ from urllib.parse import parse_qsl
 
 import can
 
-from dbc.errors import BusError, BusInitError
+from dbc.errors import BusError, BusInitError, ConfigError
 
 DEFAULT_SOCKETCAN_CHANNEL = "vcan0"
 PORTABLE_INTERFACE = "hilbus"
@@ -49,6 +54,9 @@ MEMBER_STALL_OPTION = "member_stall_s"
 SYS_NET = Path("/sys/class/net")
 SOCKETCAN_RCVBUF_BYTES = 8 * 1024 * 1024  # ~10 000 queued frames (kernel skb accounting)
 SO_RCVBUFFORCE = getattr(socket, "SO_RCVBUFFORCE", 33)  # Linux value; missing on some builds
+# python-can interfaces whose bus lives inside one process (can.interfaces.virtual)
+IN_PROCESS_INTERFACES = frozenset({"virtual"})
+SPEC_FORM = "INTERFACE:CHANNEL[?key=value&...], e.g. socketcan:vcan0 or hilbus:default"
 
 
 @dataclass(frozen=True)
@@ -87,6 +95,26 @@ class BusSpec:
     def is_portable(self) -> bool:
         """True for the project's own cross-process bus."""
         return self.interface == PORTABLE_INTERFACE
+
+
+def check_bus_spec(spec: str, option: str = "--bus", source: str = "command line") -> BusSpec:
+    """``spec`` parsed, with an interface python-can has that crosses processes.
+
+    Raises ConfigError(source, option, spec, expected) otherwise; opens nothing.
+    """
+    try:
+        bs = BusSpec.parse(spec)
+    except BusError:
+        raise ConfigError(source, option, spec, SPEC_FORM) from None
+    if bs.interface not in can.interfaces.VALID_INTERFACES:
+        known = ", ".join(sorted(can.interfaces.VALID_INTERFACES - IN_PROCESS_INTERFACES))
+        raise ConfigError(source, option, spec, f"a python-can interface: one of {known}")
+    if bs.interface in IN_PROCESS_INTERFACES:
+        raise ConfigError(source, option, spec, "an interface that other processes share "
+                          f"(a {bs.interface} bus exists inside one process: the bench, the "
+                          "flight software and the tools are separate processes and would "
+                          "never hear each other; use hilbus:NAME or socketcan:IFACE)")
+    return bs
 
 
 def mode_options(spec: str, mode: str) -> dict[str, object]:

@@ -23,13 +23,16 @@ import subprocess
 import sys
 import tempfile
 import uuid
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
 from bench.scenario.load import load_scenario
+from dbc import options as opt
 from dbc.errors import ConfigError, RunError
 from dbc.faults import STUCK_CLOSED, STUCK_OPEN
+from dbc.options import StrictParser
 from dbc.records import write_record
 from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
@@ -41,6 +44,8 @@ COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruste
            "final_position_error_m", "propellant_kg", "run_dir"]
 DPI = 110
 PROCESSES_PER_RUN = 2  # bench + flight software
+BAR_WIDTH = 30  # characters of the terminal progress bar
+MAX_JOBS = 64  # runs at a time: 128 processes, far more than the CPUs of any bench host
 
 
 def _run_one(scenario: Path, fault: str, out: Path, xdg: Path, spin_off: bool) -> dict[str, Any]:
@@ -81,14 +86,20 @@ def _row(k: int, kind: str, fault_t_s: float, s: dict[str, Any], run_dir: Path) 
 
 
 def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
-                 kinds: tuple[str, ...] = KINDS) -> list[dict[str, Any]]:
-    """Run every single-thruster failure of ``kinds``; write the CSV, JSON and PNG."""
+                 kinds: tuple[str, ...] = KINDS,
+                 progress: Callable[[int, int, dict[str, Any]], None] | None = None,
+                 ) -> list[dict[str, Any]]:
+    """Run every single-thruster failure of ``kinds``; write the CSV, JSON and PNG.
+
+    ``progress(done, total, row)`` is called as each run finishes (in the order they
+    finish); the rows returned are in case order.
+    """
     sc = load_scenario(scenario)
     if not 0.0 <= fault_t_s < sc.duration_s:  # also NaN
         raise ConfigError("command line", "--fault-time", fault_t_s,
                           f"a time in [0, {sc.duration_s:g}) s (the scenario's duration)")
-    if jobs < 1:
-        raise ConfigError("command line", "--jobs", jobs, "at least 1")
+    if not 1 <= jobs <= MAX_JOBS:
+        raise ConfigError("command line", "--jobs", jobs, f"an integer in [1, {MAX_JOBS}]")
     n = len(sc.thrusters)
     out.mkdir(parents=True, exist_ok=True)
     cases = [(k, kind) for kind in kinds for k in range(n)]
@@ -107,6 +118,10 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             futures = [pool.submit(job, case) for case in cases]
             try:
+                for done, fut in enumerate(as_completed(futures), start=1):
+                    row = fut.result()
+                    if progress is not None:
+                        progress(done, len(cases), row)
                 rows = [fut.result() for fut in futures]
             except BaseException:  # one run failed: do not start the others
                 for fut in futures:
@@ -149,37 +164,74 @@ def _plot(rows: list[dict[str, Any]], path: Path) -> None:
 
 
 def add_arguments(p: argparse.ArgumentParser, default_jobs: int) -> None:
-    """The campaign's options (shared with ``thruster-hil campaign``)."""
-    p.add_argument("scenario", help="scenario TOML file (its thrusters, duration, seed)")
-    p.add_argument("--out", required=True, help="folder for campaign.csv/.json/.png and runs")
-    p.add_argument("--fault-time", type=float, default=DEFAULT_FAULT_TIME_S,
-                   help=f"when each fault starts [s] (default {DEFAULT_FAULT_TIME_S:g})")
-    p.add_argument("--jobs", type=int, default=default_jobs,
-                   help=f"runs at a time (default {default_jobs})")
-    p.add_argument("--kinds", nargs="+", choices=KINDS, default=list(KINDS),
-                   help="failure kinds (default both)")
+    """The campaign's options (shared with ``thruster-hil campaign``), each checked as it is
+    parsed (:mod:`dbc.options`); the fault time against the scenario's duration later."""
+    p.add_argument("scenario", type=opt.text("SCENARIO", "a scenario file"),
+                   help="scenario TOML file (its thrusters, duration, seed)")
+    p.add_argument("--out", required=True, type=opt.text("--out", "a folder path"),
+                   help="folder for campaign.csv/.json/.png and runs")
+    p.add_argument("--fault-time", type=opt.number("--fault-time", 0.0, unit="s"),
+                   default=DEFAULT_FAULT_TIME_S,
+                   help="when each fault starts [s], before the scenario's end "
+                   f"(default {DEFAULT_FAULT_TIME_S:g})")
+    p.add_argument("--jobs", type=opt.integer("--jobs", 1, MAX_JOBS), default=default_jobs,
+                   help=f"runs at a time, 1..{MAX_JOBS} (default {default_jobs})")
+    p.add_argument("--kinds", nargs="+", type=opt.choice("--kinds", KINDS),
+                   default=list(KINDS), metavar="KIND",
+                   help=f"failure kinds: {' '.join(KINDS)} (default both)")
+
+
+def _row_line(r: dict[str, Any]) -> str:
+    """One run's outcome as the console shows it."""
+    return (f"T{r['thruster']:02d} {r['kind']:12s} detected={r['detected']!s:5} "
+            f"t={r['detection_time_s']} isolated={r['isolated_thruster']} "
+            f"ok={r['isolation_correct']} expectations={r['expectations_met']}")
+
+
+def _progress_printer() -> Callable[[int, int, dict[str, Any]], None]:
+    """On a terminal: a progress bar on stderr, redrawn per finished run. Otherwise (a
+    log, a pipe, CI): one line per finished run on stdout, flushed at once, so that a
+    redirected campaign of many minutes shows its runs as they end."""
+    tty = sys.stderr.isatty()
+
+    def show(done: int, total: int, row: dict[str, Any]) -> None:
+        if tty:
+            n = done * BAR_WIDTH // total
+            sys.stderr.write(f"\r[{'#' * n}{'.' * (BAR_WIDTH - n)}] {done}/{total} runs "
+                             f"(last: T{row['thruster']:02d} {row['kind']})")
+            if done == total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+        else:
+            print(f"[{done}/{total}] {_row_line(row)}", flush=True)
+
+    return show
 
 
 def main(argv: list[str] | None = None) -> int:
     """Command line; exit 0 if every run was detected, isolated and met its expectations."""
-    p = argparse.ArgumentParser(prog="thruster-hil campaign", description=__doc__.split("\n")[0])
+    p = StrictParser(prog="thruster-hil campaign", description=__doc__.split("\n")[0])
     add_arguments(p, default_jobs=max(1, (os.cpu_count() or 2) // 2))
-    args = p.parse_args(argv)
+    args = opt.parse_or_exit_code(p, argv)
+    if isinstance(args, int):
+        return args
     try:
         rows = run_campaign(Path(args.scenario), Path(args.out), args.fault_time, args.jobs,
-                            tuple(args.kinds))
+                            tuple(args.kinds), _progress_printer())
     except ConfigError as exc:
         print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except RunError as exc:
         print(f"thruster-hil campaign: run error: {exc}", file=sys.stderr)
         return EXIT_RUN_ERROR
-    for r in rows:
-        print(f"T{r['thruster']:02d} {r['kind']:12s} detected={r['detected']!s:5} "
-              f"t={r['detection_time_s']} isolated={r['isolated_thruster']} "
-              f"ok={r['isolation_correct']} expectations={r['expectations_met']}")
-    ok = all(r["detected"] and r["isolation_correct"] and r["expectations_met"] for r in rows)
-    return 0 if ok else 1
+    if sys.stderr.isatty():  # a redirected campaign has printed each run as it ended
+        for r in rows:
+            print(_row_line(r))
+    passed = sum(bool(r["detected"] and r["isolation_correct"] and r["expectations_met"])
+                 for r in rows)
+    print(f"campaign: {passed}/{len(rows)} runs detected, isolated and met the expectations; "
+          f"{Path(args.out) / 'campaign.csv'}")
+    return 0 if passed == len(rows) else 1
 
 
 if __name__ == "__main__":

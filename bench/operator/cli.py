@@ -21,12 +21,16 @@ from pathlib import Path
 from typing import Any
 
 from bench.operator.lifecycle import Stopped
+from dbc import options as opt
+from dbc.datafile import parse_json, read_text
 from dbc.errors import BusError, ConfigError, IcdError, RunError
-from transport.spec import BusSpec, default_bus_spec, private_bus_spec
+from dbc.options import StrictParser
+from transport.spec import BusSpec, check_bus_spec, default_bus_spec, private_bus_spec
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 BAR_WIDTH = 30
+MAX_SUMMARY_BYTES = 64 << 20  # a summary.json of a long run with many faults: a few MB
 
 
 def _progress_printer() -> Any:
@@ -144,14 +148,27 @@ def _cmd_report(args: argparse.Namespace) -> int:
     path = run_dir / "summary.json"
     if not path.exists():
         raise ConfigError(str(run_dir), "summary.json", None, "a run folder (no summary.json)")
-    s = json.loads(path.read_text(encoding="utf-8"))
-    for p in plot_run(run_dir, s.get("settling_band_deg")):
-        print(f"wrote {p}")
-    _print_summary(s, run_dir)
+    s = parse_json(read_text(path, "summary.json", MAX_SUMMARY_BYTES), str(path))
+    if not isinstance(s, dict):
+        raise ConfigError(str(path), "<root>", s, "a summary.json written by thruster-hil")
+    try:
+        for p in plot_run(run_dir, s.get("settling_band_deg")):
+            print(f"wrote {p}")
+        _print_summary(s, run_dir)
+    except KeyError as exc:
+        raise ConfigError(str(path), str(exc.args[0]), None, "a summary.json written by "
+                          "thruster-hil (this key is missing)") from exc
+    except (TypeError, ValueError, AttributeError) as exc:
+        raise ConfigError(str(path), "<content>", str(exc), "a summary.json written by "
+                          "thruster-hil") from exc
     return EXIT_OK if s.get("passed") else EXIT_FAILED
 
 
 def _cmd_timing(args: argparse.Namespace) -> int:
+    from bench.operator.analysis.defaults import (
+        DEFAULT_FIRST_FRAME_TIMEOUT_S,
+        DEFAULT_LIVE_DURATION_S,
+    )
     from bench.operator.analysis.live import LiveOptions, live_timing
     from bench.operator.analysis.records import TimingOptions
     from bench.operator.analysis.report import format_report, write_histograms, write_json
@@ -159,6 +176,10 @@ def _cmd_timing(args: argparse.Namespace) -> int:
 
     if args.live == (args.run_dir is not None):
         raise ConfigError("timing", "RUN_DIR/--live", args.run_dir, "a run folder or --live")
+    for dest in LIVE_ONLY if not args.live else ():
+        if getattr(args, dest) is not None:
+            opt.refuse("--" + dest.replace("_", "-"), getattr(args, dest),
+                       "absent without --live (a run folder has its own bus and duration)")
     options = TimingOptions(
         window_ms=args.window_ms,
         cycle_abs_tolerance_ms=None if args.abs_tol_ms < 0 else args.abs_tol_ms,
@@ -167,7 +188,11 @@ def _cmd_timing(args: argparse.Namespace) -> int:
     if args.live:
         bus = args.bus or default_bus_spec()
         BusSpec.parse(bus)
-        live = LiveOptions(args.duration, args.first_frame_timeout, args.bitrate)
+        live = LiveOptions(
+            DEFAULT_LIVE_DURATION_S if args.duration is None else args.duration,
+            DEFAULT_FIRST_FRAME_TIMEOUT_S if args.first_frame_timeout is None
+            else args.first_frame_timeout,
+            args.bitrate)
 
         def listening() -> None:
             print(
@@ -202,56 +227,81 @@ def _cmd_timing(args: argparse.Namespace) -> int:
     return EXIT_FAILED if args.strict and (rt.flagged() or rt.unheard()) else EXIT_OK
 
 
+MODES = ("lockstep", "realtime")
+SCENARIO_HELP = "scenario TOML file"
+# --live: a CAN classic bitrate (ISO 11898-1: at most 1 Mbit/s; 5 kbit/s is the lowest that
+# CAN controllers commonly configure)
+LIVE_BITRATE_BPS = (5_000, 1_000_000)
+# timing: bus-load window (10 us, ten bit times at 1 Mbit/s, to an hour) and tolerances
+WINDOW_MS = (0.01, 3_600_000.0)
+MAX_TOLERANCE_MS = 1e6
+MAX_TOLERANCE_PCT = 100.0
+LIVE_ONLY = ("bus", "duration", "first_frame_timeout", "bitrate")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of ``thruster-hil``."""
-    p = argparse.ArgumentParser(prog="thruster-hil", description=__doc__.split("\n")[0])
-    sub = p.add_subparsers(dest="command", required=True)
+    """The argument parser of ``thruster-hil`` (every option checked: :mod:`dbc.options`)."""
+    from bench.scenario.limits import MAX_DURATION_S, SEED_MAX
+
+    p = StrictParser(prog="thruster-hil", description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name, help_ in (
         ("run", "run a scenario: bench + flight software"),
         ("bench", "run the bench alone; pair it with external flight software"),
     ):
         r = sub.add_parser(name, help=help_)
-        r.add_argument("scenario", help="scenario TOML file")
-        r.add_argument("--mode", choices=("lockstep", "realtime"), default="lockstep")
-        r.add_argument(
-            "--bus",
-            help="bus spec INTERFACE:CHANNEL, e.g. socketcan:vcan0 or hilbus:lab (default: "
-            "a portable-bus channel of this run's own, printed at the start; on a named bus "
-            "another run is detected and refused)",
-        )
-        r.add_argument("--seed", type=int, help="random seed (default: the scenario's)")
-        r.add_argument("--out", help="run folder, new or empty (default: "
-                       "runs/<scenario>-<time>-<hex>, a new folder)")
+        r.add_argument("scenario", type=opt.text("SCENARIO", "a scenario file"),
+                       help=SCENARIO_HELP)
+        r.add_argument("--mode", type=opt.choice("--mode", MODES), default="lockstep",
+                       metavar="{lockstep,realtime}",
+                       help="lockstep: the bench is the time master, one SYNC per control "
+                       "cycle, deterministic; realtime: paced by the wall clock, measured "
+                       "latency (default lockstep)")
+        r.add_argument("--bus", type=_bus_option("--bus"),
+                       help="bus spec INTERFACE:CHANNEL, e.g. socketcan:vcan0 or hilbus:lab "
+                       "(default: a portable-bus channel of this run's own, printed at the "
+                       "start; on a named bus another run is detected and refused)")
+        r.add_argument("--seed", type=opt.integer("--seed", 0, SEED_MAX),
+                       help=f"random seed, 0..{SEED_MAX} (default: the scenario's)")
+        r.add_argument("--out", type=opt.text("--out", "a folder path"),
+                       help="run folder, new or empty (default: runs/<scenario>-<time>-<hex>, "
+                       "a new folder)")
         r.add_argument("--replace", action="store_true",
                        help="let --out name a folder holding an earlier run, which is deleted")
-        r.add_argument("--duration", type=float, help="override the scenario duration [s]")
+        r.add_argument("--duration", type=opt.number("--duration", control_period_s,
+                                                     MAX_DURATION_S, unit="s"),
+                       help="override the scenario duration [s] (one control period to "
+                       f"{MAX_DURATION_S:g})")
         r.add_argument("--set", dest="overrides", action="append", default=[],
                        metavar="KEY=VALUE",
                        help="override a scenario value, e.g. --set bus.bitrate_bps=125000 "
                        "(repeatable; TOML values)")
         if name == "run":
             r.add_argument(
-                "--fsw-cmd",
+                "--fsw-cmd", type=opt.text("--fsw-cmd", "a command line"),
                 help="flight-software command; placeholders {bus} {mode} "
                 "{config} {stats} {rx_log} {run_dir}",
             )
     rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
-    rp.add_argument("run_dir")
+    rp.add_argument("run_dir", metavar="RUN_DIR", type=opt.text("RUN_DIR", "a run folder"),
+                    help="a run folder (with summary.json), as `run --out` names it")
     _add_timing_parser(sub)
     inj = sub.add_parser("inject", help="inject or clear a fault live on a running bench "
                          "(a FAULT_CMD frame, acknowledged by the bench)")
-    inj.add_argument("kind", help="fault kind, e.g. stuck_open, degraded, drop, bus_off, outage")
-    inj.add_argument("--bus", help="bus spec of the running bench")
-    inj.add_argument("--target", type=_integer, required=True,
+    inj.add_argument("kind", type=opt.text("KIND", "a fault kind"),
+                     help="fault kind, e.g. stuck_open, degraded, drop, bus_off, outage")
+    inj.add_argument("--bus", type=_bus_option("--bus"),
+                     help="bus spec of the running bench (default as for run)")
+    inj.add_argument("--target", type=opt.integer("--target"), required=True,
                      help="thruster index, sensor index (0 gyro, 1 accelerometer, 2 star "
                      "tracker), message CAN ID (e.g. 0x40) or node index (0 BENCH, 1 FSW)")
-    inj.add_argument("--duration", type=float, default=0.0,
+    inj.add_argument("--duration", type=opt.number("--duration"), default=0.0,
                      help="seconds of the bench's time (simulated in lockstep, wall clock in "
                      "realtime); 0 = until cleared")
-    inj.add_argument("--param", type=float, default=0.0,
+    inj.add_argument("--param", type=opt.number("--param"), default=0.0,
                      help="the kind's parameter (factor, probability, delay s, ...)")
     inj.add_argument("--clear", action="store_true", help="clear the fault instead")
-    inj.add_argument("--print-frame", type=int, metavar="COUNTER",
+    inj.add_argument("--print-frame", type=opt.integer("--print-frame"), metavar="COUNTER",
                      help="only print the frame for cansend, with this alive counter")
     cp = sub.add_parser("campaign", help="every single-thruster stuck_closed / stuck_open "
                         "failure of a scenario, one lockstep run each; CSV + PNG")
@@ -261,18 +311,27 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _integer(text: str) -> int:
-    """An integer in any base Python reads (``3``, ``0x40``), for argparse."""
-    try:
-        return int(text, 0)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: expected an integer, e.g. 3 or 0x40") from None
+def control_period_s() -> float:
+    """The control period [s]: the DBC cycle time of the command frame (THR_CMD_0)."""
+    from bench.scenario.limits import NS_PER_S, PERIOD_MESSAGE
+    from dbc.codec import cycle_time_ns
+    from dbc.database import load_database
+
+    return cycle_time_ns(load_database(), PERIOD_MESSAGE) / NS_PER_S
+
+
+def _bus_option(option: str) -> Any:
+    """An argparse converter: a bus spec other processes can share (transport.spec)."""
+    return opt.checked(option, check_bus_spec)
 
 
 def _cmd_inject(args: argparse.Namespace) -> int:
     from bench.operator.inject import FaultCommand, cansend_string, inject
 
     cmd = FaultCommand(args.kind, args.target, args.duration, args.param, args.clear)
+    if args.print_frame is not None and args.bus is not None:
+        opt.refuse("--bus", args.bus, "absent with --print-frame (the frame is printed, "
+                   "not sent)")
     if args.print_frame is not None:
         print(cansend_string(cmd, args.print_frame))
         return EXIT_OK
@@ -298,6 +357,7 @@ def _add_timing_parser(sub: Any) -> None:
         DEFAULT_LIVE_DURATION_S,
         DEFAULT_WINDOW_MS,
     )
+    from bench.scenario.limits import MAX_DURATION_S
 
     t = sub.add_parser(
         "timing",
@@ -306,25 +366,28 @@ def _add_timing_parser(sub: Any) -> None:
         "worst-case bound, missed cycles, cycle-time violations; the IMU->command->valve "
         "chain; bus load per window and per node.",
     )
-    t.add_argument("run_dir", nargs="?", help="run folder (omit with --live)")
+    t.add_argument("run_dir", nargs="?", metavar="RUN_DIR",
+                   type=opt.text("RUN_DIR", "a run folder"),
+                   help="run folder (omit with --live)")
     t.add_argument(
         "--window-ms",
-        type=float,
+        type=opt.number("--window-ms", *WINDOW_MS, unit="ms"),
         default=DEFAULT_WINDOW_MS,
-        help=f"bus-load window [ms] (default {DEFAULT_WINDOW_MS:g})",
+        help=f"bus-load window [ms], {WINDOW_MS[0]:g}..{WINDOW_MS[1]:g} "
+        f"(default {DEFAULT_WINDOW_MS:g})",
     )
     t.add_argument(
         "--abs-tol-ms",
-        type=float,
+        type=opt.number("--abs-tol-ms", hi=MAX_TOLERANCE_MS, unit="ms"),
         default=DEFAULT_CYCLE_ABS_TOLERANCE_MS,
         help="absolute cycle-time window, ± ms around GenMsgCycleTime; negative: "
         f"off (default {DEFAULT_CYCLE_ABS_TOLERANCE_MS:g})",
     )
     t.add_argument(
         "--rel-tol-pct",
-        type=float,
+        type=opt.number("--rel-tol-pct", hi=MAX_TOLERANCE_PCT, hi_open=True, unit="%"),
         default=DEFAULT_CYCLE_REL_TOLERANCE_PCT,
-        help="relative cycle-time window, ± %% of GenMsgCycleTime; negative: off "
+        help="relative cycle-time window, ± %% of GenMsgCycleTime, below 100; negative: off "
         f"(default {DEFAULT_CYCLE_REL_TOLERANCE_PCT:g})",
     )
     t.add_argument("--json", action="store_true", help="print JSON instead of the table")
@@ -335,31 +398,34 @@ def _add_timing_parser(sub: Any) -> None:
         "its sender sent never reached the trace",
     )
     t.add_argument("--live", action="store_true", help="listen to a running bus instead")
-    t.add_argument("--bus", help="--live: bus spec INTERFACE:CHANNEL (default as for run)")
+    t.add_argument("--bus", type=_bus_option("--bus"),
+                   help="--live: bus spec INTERFACE:CHANNEL (default as for run)")
     t.add_argument(
         "--duration",
-        type=float,
-        default=DEFAULT_LIVE_DURATION_S,
+        type=opt.number("--duration", 0.0, MAX_DURATION_S, lo_open=True, unit="s"),
         help="--live: seconds to listen from the first frame "
         f"(default {DEFAULT_LIVE_DURATION_S:g})",
     )
     t.add_argument(
         "--first-frame-timeout",
-        type=float,
-        default=DEFAULT_FIRST_FRAME_TIMEOUT_S,
+        type=opt.number("--first-frame-timeout", 0.0, MAX_DURATION_S, lo_open=True,
+                        unit="s"),
         help="--live: seconds to wait for the first frame "
         f"(default {DEFAULT_FIRST_FRAME_TIMEOUT_S:g})",
     )
     t.add_argument(
         "--bitrate",
-        type=int,
-        help="--live: bitrate for the load estimate [bit/s] (default: the DBC's)",
+        type=opt.integer("--bitrate", *LIVE_BITRATE_BPS),
+        help="--live: bitrate for the load estimate [bit/s], "
+        f"{LIVE_BITRATE_BPS[0]}..{LIVE_BITRATE_BPS[1]} (default: the DBC's)",
     )
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``thruster-hil`` console script."""
-    args = build_parser().parse_args(argv)
+    args = opt.parse_or_exit_code(build_parser(), argv)
+    if isinstance(args, int):
+        return args
     try:
         if args.command == "report":
             return _cmd_report(args)

@@ -92,10 +92,13 @@ def send_flood(bus: can.BusABC, frames: list[can.Message], rate_hz: float) -> fl
 def main(argv: list[str] | None = None) -> None:
     """Command line: flood a bus and print what was sent as JSON."""
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--bus", required=True)
-    p.add_argument("--frames", type=int, default=100_000)
-    p.add_argument("--rate-hz", type=float, default=DEFAULT_RATE_HZ)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--bus", required=True, help="bus spec of the run to flood")
+    p.add_argument("--frames", type=int, default=100_000,
+                   help="how many frames to send (default 100000)")
+    p.add_argument("--rate-hz", type=float, default=DEFAULT_RATE_HZ,
+                   help=f"frames per second (default {DEFAULT_RATE_HZ:g})")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the flood (the same seed gives the same frames; default 0)")
     args = p.parse_args(argv)
     frames, counts = build_flood(args.frames, args.seed)
     with open_bus(args.bus) as bus:

@@ -1,6 +1,7 @@
 """Scenario files: read the TOML, apply ``--set KEY=VALUE`` overrides, validate.
 
-:func:`load_scenario` reads a file (errors name it: unreadable, not TOML), applies the
+:func:`load_scenario` reads a file (errors name it: unreadable, too large, not UTF-8, not
+TOML, nested too deep: :mod:`dbc.datafile`), applies the
 overrides (:func:`apply_overrides`; an error names the override) and hands the data to
 :func:`bench.scenario.parse.parse_scenario`. A validation error caused by an override is
 reported against the override, not the file.
@@ -10,18 +11,13 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import sys
 from pathlib import Path
 from typing import Any
 
 from bench.scenario.parse import parse_scenario
 from bench.scenario.spec import Scenario, override_source
+from dbc.datafile import SYNTAX_KEY, check_nesting, parse_toml, read_text
 from dbc.errors import ConfigError
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 
 def apply_overrides(data: dict[str, Any], overrides: list[str], source: str) -> None:
@@ -37,8 +33,10 @@ def apply_overrides(data: dict[str, Any], overrides: list[str], source: str) -> 
         if not sep or not key:
             raise ConfigError(source, "--set", item, "KEY=VALUE with a dotted KEY")
         try:
-            value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
+            value = parse_toml(f"v = {text}", source)["v"]
+        except ConfigError as exc:
+            if exc.key != SYNTAX_KEY:  # too deep, too many digits: not a string either
+                raise ConfigError(source, "--set", item, exc.expected) from exc
             value = text
         table = data
         parts = [_override_part(source, key, p) for p in key.split(".")]
@@ -75,17 +73,9 @@ def _override_part(source: str, key: str, part: str) -> tuple[str, int | None]:
 def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:
     """Read and validate the scenario file at ``path``, after ``KEY=VALUE`` overrides."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError(
-            str(p), "<file>", str(p), f"a readable scenario file ({exc.strerror})"
-        ) from exc
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(str(p), "<syntax>", str(exc), "valid TOML") from exc
+    data = parse_toml(read_text(p, "scenario file"), str(p))
     apply_overrides(data, overrides or [], str(p))
+    check_nesting(data, override_source(str(p), list(overrides or [])))
     try:
         sc = parse_scenario(data, str(p))
     except ConfigError as exc:

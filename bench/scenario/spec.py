@@ -21,6 +21,7 @@ from bench.station.environment.disturbance import DisturbanceParams
 from bench.station.faults import FaultSpec
 from bench.station.reference import KIND_STEP, ReferenceParams
 from dbc.contract import FswConfig, Manoeuvre, ThrusterConfig, ValveTiming
+from dbc.errors import BRIEF_CHARS
 
 FSW_TABLE = "flight_sw"  # the table passed through to the flight software
 TRANSLATIONS = ("inertial", "hcw")
@@ -226,4 +227,5 @@ def override_source(path: str, items: list[str]) -> str:
     """Where a value came from: the file, or the ``--set`` items applied to it."""
     if not items:
         return path
-    return "command line " + " ".join(f"--set {i}" for i in items) + f" (on {path})"
+    cut = [i if len(i) <= BRIEF_CHARS else i[:BRIEF_CHARS] + "..." for i in items]
+    return "command line " + " ".join(f"--set {i}" for i in cut) + f" (on {path})"

@@ -40,6 +40,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from bench.scenario.limits import MAX_DURATION_S
 from dbc.errors import ConfigError
 from dbc.faults import (
     BABBLING,
@@ -110,7 +111,7 @@ def parse_faults(tables: list[Table], duration_s: float, n_thrusters: int,
     for f in tables:
         t_s = f.number("t_s", lo=0.0, hi=duration_s)
         kind = f.string("kind", choices=FAULT_KINDS)
-        dur = f.number("duration_s", 0.0, lo=0.0)
+        dur = f.number("duration_s", 0.0, lo=0.0, hi=MAX_DURATION_S)
         if kind in THRUSTER_KINDS:
             k = f.integer("thruster", lo=0)
             if k >= n_thrusters:

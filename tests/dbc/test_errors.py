@@ -78,3 +78,25 @@ def test_bus_errors_are_python_can_errors_and_the_projects(
 def test_a_malformed_spec_is_a_bus_error_but_no_python_can_error() -> None:
     """BusError itself is the project's (a malformed bus spec), not a python-can error."""
     assert not issubclass(BusError, can.CanError)
+
+
+def test_a_huge_value_is_shown_briefly() -> None:
+    """A 5-million-element value: the message names its type and length and stays short."""
+    big = [0] * 5_000_000
+    text = str(errors.ConfigError("f.toml", "vehicle.mass_kg", big, "a number"))
+    assert "list of 5000000 items: [0, 0, 0, 0, 0, 0, ...]" in text
+    assert len(text) < 2 * errors.BRIEF_CHARS
+
+
+def test_deep_and_long_values_are_shown_briefly() -> None:
+    """A 100 000-deep list, a long string and a 5000-digit integer: short, no RecursionError."""
+    deep: list[object] = []
+    inner = deep
+    for _ in range(100_000):
+        nxt: list[object] = []
+        inner.append(nxt)
+        inner = nxt
+    assert errors.brief(deep) == "list of 1 item: [[[[...]]]]"
+    assert errors.brief("x" * 1000).startswith("str of 1000 chars: 'xxx")
+    assert errors.brief(10**5000) == "int of about 5001 digits"
+    assert errors.brief([1.5, -1]) == "[1.5, -1]"

@@ -55,3 +55,8 @@ def test_every_single_thruster_failure_is_detected_isolated_and_survived(tmp_pat
         assert r["expectations_met"] == "True", case
     assert (out / "campaign.png").stat().st_size > 0
     assert p.returncode == 0, p.stdout[-2000:]
+    # redirected (not a terminal): one line per run as it finished, numbered, then the verdict
+    progress = [ln for ln in p.stdout.splitlines() if ln.startswith("[")]
+    assert [ln.split("]")[0] for ln in progress] == [
+        f"[{i}/{2 * N_THRUSTERS}" for i in range(1, 2 * N_THRUSTERS + 1)]
+    assert p.stdout.splitlines()[-1].startswith(f"campaign: {2 * N_THRUSTERS}/{2 * N_THRUSTERS}")

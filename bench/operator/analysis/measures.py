@@ -49,6 +49,7 @@ import numpy as np
 from bench.operator.analysis.records import (
     MS_PER_S,
     NAN,
+    OPTIONS_SOURCE,
     PCT,
     BusLoad,
     ChainTiming,
@@ -58,6 +59,10 @@ from bench.operator.analysis.records import (
 from bench.operator.analysis.rta import messages_from_dbc, response_times
 from bench.operator.analysis.tables import NO_COUNTER, ChainTable, FrameTable
 from dbc.e2e import COUNTER_MODULUS
+from dbc.errors import ConfigError
+
+# Most bus-load windows in one analysis (a float each, per node): 10 million = 80 MB.
+MAX_LOAD_WINDOWS = 10_000_000
 
 
 def period_stats_s(t_s: np.ndarray) -> tuple[float, float, float]:
@@ -248,6 +253,11 @@ def bus_load(
         return BusLoad(window_ms, bitrate_bps, 0, empty, {})
     t0 = math.floor(float(start.min()) / window_s) * window_s
     n = max(1, math.ceil((float(end.max()) - t0) / window_s))
+    if n > MAX_LOAD_WINDOWS:  # each window is a float per node: refuse, do not exhaust memory
+        span_s = float(end.max()) - t0
+        raise ConfigError(OPTIONS_SOURCE, "window_ms (--window-ms)", window_ms,
+                          f"at least {span_s * MS_PER_S / MAX_LOAD_WINDOWS:.3g} ms for this "
+                          f"{span_s:g} s run (at most {MAX_LOAD_WINDOWS} windows)")
     total = _load_figures(window_busy_s(start, end, t0, window_s, n), t0, window_s)
     node_of = np.asarray(nodes, dtype=object)[rows]
     per_node = {}

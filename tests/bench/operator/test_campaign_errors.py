@@ -12,9 +12,9 @@ QUICKSTART = Path(__file__).resolve().parents[3] / "scenarios" / "quickstart.tom
 
 
 @pytest.mark.parametrize("option, value, says", [
-    ("--fault-time", "-5", "--fault-time = -5.0: expected a time in [0, 60) s"),
+    ("--fault-time", "-5", "--fault-time = '-5': expected a finite number >= 0 [s]"),
     ("--fault-time", "60", "--fault-time = 60.0"),
-    ("--jobs", "0", "--jobs = 0: expected at least 1"),
+    ("--jobs", "0", "--jobs = '0': expected an integer in [1, 64]"),
 ])
 def test_bad_options_exit_2_before_any_run(option: str, value: str, says: str, tmp_path: Path,
                                            capsys: pytest.CaptureFixture[str]) -> None:

@@ -22,7 +22,7 @@ def _run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]
 
 
 @pytest.mark.parametrize("bus, says", [
-    ("nosuch:foo", 'Unknown interface type "nosuch"'),
+    ("nosuch:foo", "--bus = 'nosuch:foo': expected a python-can interface: one of"),
     ("hilbus:a/b", "hilbus channel 'a/b'"),
 ])
 def test_bad_bus_exits_2_naming_it(bus: str, says: str, tmp_path: Path, runtime: Path,

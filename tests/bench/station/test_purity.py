@@ -15,7 +15,7 @@ FORBIDDEN = frozenset({"time", "datetime", "socket", "select", "selectors", "os"
                        "can", "asyncio", "csv", "json", "tomllib", "tomli", "sys"})
 # project modules outside the station that the station may import: their own imports are
 # checked the same way (the closure below)
-ALLOWED_OUTSIDE = ("bench.scenario.spec", "bench.scenario", "bench")
+ALLOWED_OUTSIDE = ("bench.scenario.spec", "bench.scenario.limits", "bench.scenario", "bench")
 # the project's error tree derives its bus errors from python-can's exception classes
 # (can.CanError ...): it imports python-can for those classes, and opens no bus
 EXCEPTION_BASES = {("dbc/errors.py", "can")}
