@@ -11,6 +11,8 @@ merges it into
 
 from __future__ import annotations
 
+from array import array
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -21,6 +23,7 @@ from flight_sw.computer import CycleResult, FlightComputer
 NS_PER_US = 1e3
 NS_PER_S = 1e9
 CYCLE_TIME_DIGITS = 1  # 0.1 us
+INT64, FLOAT64 = "q", "d"  # array type codes of the per-cycle series
 EVIDENCE = ("unexpected", "sequence")  # receive causes that show a second sender
 
 
@@ -32,18 +35,21 @@ class NodeStats:
     overruns: int = 0
     restarts: int = 0
     sent: dict[str, int] = field(default_factory=dict)
-    cycle_ns: list[int] = field(default_factory=list)  # cycle start -> last frame sent
-    residual_Nm: list[float] = field(default_factory=list)  # allocation torque residual
-    residual_N: list[float] = field(default_factory=list)  # allocation force residual
+    # per cycle, packed (8 bytes a value, not a Python object each: a 2 h run's 360 000
+    # cycles keep 2.9 MB a series): cycle start -> last frame sent [ns], the allocation's
+    # torque [N m] and force [N] residuals
+    cycle_ns: array[int] = field(default_factory=lambda: array(INT64))
+    residual_Nm: array[float] = field(default_factory=lambda: array(FLOAT64))
+    residual_N: array[float] = field(default_factory=lambda: array(FLOAT64))
     saturated_cycles: int = 0
 
 
-def spread(values: list[float]) -> dict[str, float | int | None]:
+def spread(values: Sequence[float]) -> dict[str, float | int | None]:
     """p50, p99, max (full precision; the bus carries 0.05 steps) and the count."""
     return percentile_summary(values)
 
 
-def percentiles_us(samples_ns: list[int]) -> dict[str, float | int | None]:
+def percentiles_us(samples_ns: Sequence[int]) -> dict[str, float | int | None]:
     """p50, p99 and max of ``samples_ns`` in microseconds (0.1 us), and the count."""
     return percentile_summary(samples_ns, NS_PER_US, CYCLE_TIME_DIGITS)
 

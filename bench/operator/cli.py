@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.operator.lifecycle import Stopped
+from bench.operator.verdict import abnormal, verdict
 from dbc import options as opt
 from dbc.datafile import parse_json, read_text
 from dbc.errors import BusError, ConfigError, IcdError, RunError
@@ -60,6 +61,19 @@ def _settling_text(settling: float | None) -> str:
     return f"{settling:.2f} s" + (" (never left the band)" if settling == 0.0 else "")
 
 
+def _position_text(s: dict[str, Any]) -> str:
+    """Position errors where the run has a position reference; else the translation the
+    firing caused (an attitude-only run has no position to be in error from)."""
+    if s.get("final_position_error_m") is not None:
+        return (f"position error final {_fmt(s['final_position_error_m'])} m, steady-state "
+                f"{_fmt(s.get('steady_state_position_error_m'))} m")
+    tr = s.get("net_translation")
+    if not tr:
+        return ""
+    return (f"translation caused by the firing (attitude only: no position reference) "
+            f"{tr['displacement_m']:.3f} m, delta-v {tr['delta_v_m_s'] * 1000:.1f} mm/s")
+
+
 def _print_summary(s: dict[str, Any], out: Path) -> None:
     lat = s["latency_us"]["sensor_to_command"]
     dm = s.get("deadline_misses") or {}
@@ -72,6 +86,7 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
         f"{_settling_text(settling)} | steady-state error "
         f"{_fmt(s['steady_state_attitude_error_deg'])} deg, "
         f"{_fmt(s['steady_state_rate_error_deg_s'])} deg/s",
+        _position_text(s),
         f"propellant {s['propellant_kg'] * 1000:.1f} g | valve openings "
         f"{(s.get('valve_openings') or {}).get('total', 'n/a')}",
         f"latency sensor->command p50 {_fmt(lat['p50'], '.0f')} us, p99 {_fmt(lat['p99'], '.0f')}"
@@ -79,6 +94,7 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
         f"flight-software overruns {dm.get('fsw_overruns', 0)}, "
         f"bench late {dm.get('bench_late', 0)}",
     ]
+    lines = [x for x in lines if x]
     if not s["converged"]:  # a run fails on this alone, with or without expectations
         lines.append(f"  FAIL converged: the attitude error did not end inside the "
                      f"{_fmt(s.get('settling_band_deg'), 'g')} deg settling band")
@@ -89,6 +105,9 @@ def _print_summary(s: dict[str, Any], out: Path) -> None:
         lines.append(f"  WARNING {w}")
     if "error" in s:
         lines.append(f"  ERROR {s['error']}")
+    lines.append(f"verdict: {s.get('verdict') or verdict(s)}")
+    found = s["abnormal"] if isinstance(s.get("abnormal"), list) else abnormal(s)
+    lines += [f"  ABNORMAL {x}" for x in found] or ["  nothing abnormal"]
     lines.append(f"run folder: {out}")
     print("\n".join(lines))
 

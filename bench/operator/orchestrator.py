@@ -45,6 +45,7 @@ from bench.operator.run_warnings import (
     scenario_warnings,
 )
 from bench.operator.shared_bus import probe
+from bench.operator.verdict import abnormal, verdict
 from bench.results.counts import merge_counts, zero_unheard
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
@@ -105,10 +106,12 @@ def run_scenario(
     if opts.bus_shared:
         heard = probe(opts.bus)
         if heard:
-            raise ConfigError("command line", "--bus", opts.bus,
-                              f"a bus no other run uses (heard {', '.join(heard)} from a "
-                              "running bench or flight software; leave out --bus for a "
-                              "channel of this run's own)")
+            refusal = ConfigError("command line", "--bus", opts.bus,
+                                  f"a bus no other run uses (heard {', '.join(heard)} from a "
+                                  "running bench or flight software; leave out --bus for a "
+                                  "channel of this run's own)")
+            _write_refusal(sc, opts, refusal, heard)
+            raise refusal
     spin_s = lockstep_spin_s(available_cpus(), os.environ) if opts.mode == "lockstep" else 0.0
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -283,6 +286,7 @@ def _run_bench(
                                    f"{summary['fsw']['refused']}"
                 error = RefusedConfigError("the flight software", summary["fsw"]["refused"])
         summary["passed"] = False
+    summary["verdict"], summary["abnormal"] = verdict(summary), abnormal(summary)
     write_summary(out / "summary.json", summary)
     plot_folder(out, sc)
     if error is not None and not isinstance(error, Exception):
@@ -293,6 +297,22 @@ def _run_bench(
         tail = "".join(f"\n  fsw.log: {x}" for x in summary["fsw"].get("log_tail", []))
         raise RunError(f"run failed ({summary['error']}); run folder: {out}{tail}") from error
     return summary
+
+
+def _write_refusal(sc: Scenario, opts: RunOptions, refusal: ConfigError,
+                   heard: list[str]) -> None:
+    """summary.json of a run refused before it started (a shared bus): what it heard."""
+    summary: dict[str, Any] = {
+        "scenario": sc.name, "scenario_file": sc.path, "mode": opts.mode, "seed": opts.seed,
+        "bus": opts.bus, "sim_time_s": 0.0, "ended": "refused", "passed": False,
+        "refused": str(refusal), "second_sender_heard": heard,
+    }
+    summary["verdict"], summary["abnormal"] = verdict(summary), abnormal(summary)
+    try:
+        opts.out.mkdir(parents=True, exist_ok=True)
+        write_summary(opts.out / "summary.json", summary)
+    except OSError:
+        pass  # a folder that cannot be written: the refusal is still said on the console
 
 
 def check_bus(spec: str) -> None:

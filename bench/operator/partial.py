@@ -8,14 +8,14 @@ run, the pointing metrics of what was recorded, the frame counts and the faults 
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from bench.operator.fsw_process import fsw_report, wait_for_exit
+from bench.operator.verdict import abnormal, verdict
 from bench.results.counts import frame_table, merge_counts, zero_unheard
-from bench.results.metrics import pointing_metrics
+from bench.results.error_stats import ErrorStats
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
 from dbc.database import load_database
@@ -42,18 +42,20 @@ def partial_summary(
     out = opts.out
     wait_for_exit(out)
     db = load_database()
-    tel = _read_numeric_csv(out / "telemetry.csv")
-    t = tel.get("t_s", np.zeros(0))
-    pm = pointing_metrics(t, tel.get("att_err_deg", np.zeros(0)),
-                          tel.get("rate_err_deg_s", np.zeros(0)),
-                          sc.expectations.settling_band_deg, sc.expectations.steady_state_window_s,
-                          sc.manoeuvre_start_s)
+    errors = ErrorStats(sc.expectations.settling_band_deg,
+                        sc.expectations.steady_state_window_s, sc.manoeuvre_start_s)
+    t_last_s, propellant_kg = 0.0, 0.0
+    for row in _numeric_rows(out / "telemetry.csv",
+                             ("t_s", "att_err_deg", "rate_err_deg_s", "propellant_kg")):
+        t_last_s, att, rate, propellant_kg = row
+        if t_last_s >= sc.manoeuvre_start_s:  # as the bench's own figures (telemetry.py)
+            errors.add(t_last_s, att, rate, 0.0)
+    pm = errors.pointing()
     frames = frame_table(Icd.from_database(db))
-    fr = _read_numeric_csv(out / "frames.csv")
     name_of = {m.frame_id: m.name for m in db.messages}
     sent: dict[str, int] = {}
     received: dict[str, dict[str, Any]] = {}
-    for can_id, tx in zip(fr.get("id", []), fr.get("tx", []), strict=True):
+    for can_id, tx in _numeric_rows(out / "frames.csv", ("id", "tx")):
         name = name_of.get(int(can_id))
         if name is None:
             continue
@@ -76,11 +78,11 @@ def partial_summary(
                 faults.append(ev)
     summary: dict[str, Any] = {
         "scenario": sc.name, "scenario_file": sc.path, "mode": opts.mode, "seed": opts.seed,
-        "bus": opts.bus, "sim_time_s": float(t[-1]) if len(t) else 0.0, "wall_time_s": None,
+        "bus": opts.bus, "sim_time_s": t_last_s, "wall_time_s": None,
         "realtime_factor": None, "converged": pm.converged, "settling_time_s": pm.settling_time_s,
         "steady_state_attitude_error_deg": pm.steady_state_attitude_error_deg,
         "steady_state_rate_error_deg_s": pm.steady_state_rate_error_deg_s,
-        "propellant_kg": float(tel["propellant_kg"][-1]) if len(t) else 0.0,
+        "propellant_kg": propellant_kg,
         "valve_openings": None, "frames": frames, "rejected_other": other,
         "latency_us": {"sensor_to_command": {"p50": None, "p99": None, "max": None, "n": 0}},
         "deadline_misses": None, "faults": faults, "expectations": [], "passed": False,
@@ -92,28 +94,28 @@ def partial_summary(
     merge_counts(frames, other, "FSW", summary["fsw"].get("sent", {}),
                  summary["fsw"].get("received", {}))
     zero_unheard(frames, {"BENCH"} | ({"FSW"} if "received" in summary["fsw"] else set()))
+    summary["verdict"], summary["abnormal"] = verdict(summary), abnormal(summary)
     write_summary(out / "summary.json", summary)
     plot_folder(out, sc)
     return summary
 
 
-def _read_numeric_csv(path: Path) -> dict[str, np.ndarray]:
-    """Columns of a numeric CSV written as the run went; a line cut short at the end is skipped."""
+def _numeric_rows(path: Path, columns: tuple[str, ...]) -> Iterator[list[float]]:
+    """The ``columns`` of each row of a numeric CSV written as the run went, read line by
+    line (flat memory, however long the run); a line cut short at the end, or one that is
+    not numbers, is skipped. Nothing if the file or a column is missing."""
     if not path.exists():
-        return {}
-    lines = path.read_text(encoding="utf-8").splitlines()
-    if not lines:
-        return {}
-    head = lines[0].split(",")
-    rows = []
-    for line in lines[1:]:
-        parts = line.split(",")
-        if len(parts) != len(head):
-            continue
-        try:
-            rows.append([float(x) for x in parts])
-        except ValueError:
-            continue
-    data = np.array(rows, dtype=float).reshape(-1, len(head))
-    return {h: data[:, i] for i, h in enumerate(head)}
-
+        return
+    with open(path, encoding="utf-8") as f:
+        head = f.readline().rstrip("\n").split(",")
+        if any(c not in head for c in columns):
+            return
+        index = [head.index(c) for c in columns]
+        for line in f:
+            parts = line.rstrip("\n").split(",")
+            if len(parts) != len(head):
+                continue
+            try:
+                yield [float(parts[i]) for i in index]
+            except ValueError:
+                continue

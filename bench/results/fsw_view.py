@@ -4,8 +4,10 @@ In: decoded FSW_STATUS, FSW_ATT_EST and FSW_FDIR signals with the bench's time o
 [ns], and the true attitude at that time. Out: the flight software's mode and counters
 (telemetry, summary.json ``deadline_misses.fsw_overruns``), its attitude estimate and the
 estimate's error against the truth [deg] (telemetry), its latest FDIR report
-(summary.json ``fdir``), its restarts, and events (``fsw_isolated``, ``fsw_restart``,
-``fsw_restart_refused``) as ``(t_ns, name, fields)``.
+(summary.json ``fdir``), its restarts, its mode changes (summary.json ``fsw_mode_changes``:
+the first :data:`MAX_MODE_CHANGES` with their time, all counted), and events
+(``fsw_isolated``, ``fsw_restart``, ``fsw_restart_refused``, ``fsw_mode``) as
+``(t_ns, name, fields)``.
 
 Restarts: an FSW_STATUS in BOOT mode after one that was not is a restart only when the
 flight software had gone quiet first: no frame of it taken for at least
@@ -24,6 +26,8 @@ from dbc.quaternion import unpack_quaternion
 
 RAD_DEG = 180.0 / math.pi
 RESTART_QUIET_NS = 200_000_000
+MAX_MODE_CHANGES = 20  # mode changes kept for summary.json (a flapping mode is counted)
+NS_PER_S = 1e9
 Event = tuple[int, str, dict[str, Any]]
 
 
@@ -48,6 +52,8 @@ class FswView:
         self.fdir: dict[str, Any] = {}
         self.restarts = 0
         self.restarts_refused = 0
+        self.mode_changes: list[dict[str, Any]] = []
+        self.mode_change_count = 0
 
     @property
     def mode(self) -> int:
@@ -75,10 +81,14 @@ class FswView:
             events.append((t_ns, "fsw_restart", {"count": self.restarts}))
         elif previous is not None and mode != int(previous):
             flags = int(signals["FdirFlags"])
-            events.append((t_ns, "fsw_mode", {
+            change: dict[str, Any] = {
                 "mode": self._mode_names.get(mode, str(mode)),
                 "previous": self._mode_names.get(int(previous), str(previous)),
-                "fdir_flags": [n for n, bit in self.icd.fdir_flags.items() if flags & bit]}))
+                "fdir_flags": [n for n, bit in self.icd.fdir_flags.items() if flags & bit]}
+            events.append((t_ns, "fsw_mode", change))
+            self.mode_change_count += 1
+            if len(self.mode_changes) < MAX_MODE_CHANGES:
+                self.mode_changes.append({"t_s": t_ns / NS_PER_S, **change})
         self.status = signals
 
     def refuse_restart(self, t_ns: int, events: list[Event]) -> None:

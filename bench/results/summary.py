@@ -1,43 +1,33 @@
 """The run's figures of merit and its expectations, from the telemetry's error histories.
 
-In: the scenario (expectations: bands, windows, limits; the manoeuvre's start) and the
-attitude [deg], rate [deg/s] and position [m] errors sampled from the manoeuvre's start
-(bench.results.telemetry). Out: the summary.json fields ``converged``, settling times
-[s], steady-state and final errors, and ``expectations`` (one row per limit the scenario
-sets: value, limit, pass). Definitions in bench.results.metrics.
+In: the scenario (expectations: limits) and the streamed attitude [deg], rate [deg/s] and
+position [m] error figures from the manoeuvre's start (bench.results.error_stats, fed by
+bench.results.telemetry). Out: the summary.json fields ``converged``, settling times [s],
+steady-state and final errors, and ``expectations`` (one row per limit the scenario sets:
+value, limit, pass). Definitions in bench.results.error_stats.
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
-import numpy as np
-
-from bench.results.metrics import (
-    expectation,
-    pointing_metrics,
-    settling_expectation,
-    settling_time_s,
-)
-from bench.results.telemetry import Telemetry
+from bench.results.error_stats import ErrorStats
+from bench.results.metrics import expectation, settling_expectation
 from bench.scenario.spec import Scenario
 
 
-def expectations_and_metrics(sc: Scenario, tel: Telemetry) -> dict[str, Any]:
+def expectations_and_metrics(sc: Scenario, errors: ErrorStats) -> dict[str, Any]:
     """Convergence, settling, steady-state errors and the expectations (module docstring)."""
     e = sc.expectations
-    t_arr = np.asarray(tel.t_s)
-    pm = pointing_metrics(t_arr, np.asarray(tel.att_err_deg), np.asarray(tel.rate_err_deg_s),
-                          e.settling_band_deg, e.steady_state_window_s, sc.manoeuvre_start_s)
-    pos = np.asarray(tel.pos_err_m)
-    pos_final = float(pos[-1]) if len(pos) else 0.0
-    pos_ss = float(pos[t_arr >= t_arr[-1] - e.steady_state_window_s].max()) if len(pos) else 0.0
-    pos_settling = (settling_time_s(t_arr, pos, e.position_band_m, sc.manoeuvre_start_s)
-                    if e.position_band_m is not None else None)
-    rate_settling = (
-        settling_time_s(t_arr, np.asarray(tel.rate_err_deg_s), e.rate_settling_band_deg_s,
-                        sc.manoeuvre_start_s)
-        if e.rate_settling_band_deg_s is not None else None)
+    pm = errors.pointing()
+    pe = errors.position_errors()
+    pos_final: float | None = pe.final_error_m
+    pos_ss: float | None = pe.steady_state_error_m
+    if not sc.has_position_reference:  # attitude only: no position to be in error from
+        pos_final = pos_ss = None
+    pos_settling = None if errors.position is None else errors.position.settling_time_s()
+    rate_settling = None if errors.rate is None else errors.rate.settling_time_s()
     rows = (
         settling_expectation("settling_time_s", pm.settling_time_s, e.settling_time_s_max,
                              e.settling_band_deg, "deg"),
@@ -67,4 +57,16 @@ def expectations_and_metrics(sc: Scenario, tel: Telemetry) -> dict[str, Any]:
         "rate_settling_band_deg_s": e.rate_settling_band_deg_s,
         "rate_settling_time_s": rate_settling,
         "expectations": [x for x in rows if x is not None],
+    }
+
+
+def net_translation(sc: Scenario, r_end_N_m: tuple[float, ...],
+                    v_end_N_m_s: tuple[float, ...]) -> dict[str, Any]:
+    """How far the vehicle moved and how much its velocity changed over the run [m], [m/s]
+    (the net effect of the firing and the disturbances: in an attitude-only run the halves
+    of a thruster couple act at different instants, so they do not cancel exactly)."""
+    return {
+        "displacement_m": math.dist(r_end_N_m, sc.r0_N_m),
+        "delta_v_m_s": math.dist(v_end_N_m_s, sc.v0_N_m_s),
+        "position_reference": sc.has_position_reference,
     }

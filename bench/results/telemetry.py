@@ -5,7 +5,8 @@ r_N [m], v_N [m/s]; per-thruster thrust [N] at that instant; propellant [kg]; ac
 faults) and the flight software's last estimate (bench.results.fsw_view). Out: one row of
 ``telemetry.csv`` (columns in :func:`telemetry_columns`, units in their names), and the
 attitude error [deg], rate error [deg/s] and position error [m] from the manoeuvre's
-start on, kept for the run's metrics (bench.results.metrics).
+start on, streamed into the run's convergence figures (bench.results.error_stats: flat
+memory, however long the run).
 
 Errors: against the step target q_target_BN (rate error = |omega_BN_B|), or against the
 moving reference q_RN(t), omega_RN(t) of an MRP polynomial manoeuvre
@@ -19,6 +20,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from bench.results.error_stats import ErrorStats
 from bench.results.fsw_view import RAD_DEG, FswView, quat_error_deg
 from bench.results.writers import TelemetryWriter
 from bench.scenario.spec import Scenario
@@ -39,16 +41,16 @@ def telemetry_columns(n_thrusters: int) -> list[str]:
 
 
 class Telemetry:
-    """telemetry.csv and the error histories the metrics need."""
+    """telemetry.csv and the streamed error figures (:class:`ErrorStats`)."""
 
     def __init__(self, sc: Scenario, path: Path, n_thrusters: int, deferred: bool) -> None:
         self.sc = sc
         self.writer = TelemetryWriter(path, telemetry_columns(n_thrusters), deferred)
         self._start_ns = sc.manoeuvre_start_s * NS_PER_S
-        self.t_s: list[float] = []
-        self.att_err_deg: list[float] = []
-        self.rate_err_deg_s: list[float] = []
-        self.pos_err_m: list[float] = []
+        e = sc.expectations
+        self.errors = ErrorStats(e.settling_band_deg, e.steady_state_window_s,
+                                 sc.manoeuvre_start_s, e.rate_settling_band_deg_s,
+                                 e.position_band_m)
 
     def row(self, t_ns: int, station: Station, fsw: FswView) -> None:
         """Sample the station at ``t_ns`` (a telemetry instant)."""
@@ -71,7 +73,5 @@ class Telemetry:
         row.append(len(station.faults.active))
         self.writer.row(row)
         if t_ns >= self._start_ns:
-            self.t_s.append(t_ns / NS_PER_S)
-            self.att_err_deg.append(err)
-            self.rate_err_deg_s.append(rate_err)
-            self.pos_err_m.append(math.dist(s[7:10], sc.r_reference_N_m))
+            self.errors.add(t_ns / NS_PER_S, err, rate_err,
+                            math.dist(s[7:10], sc.r_reference_N_m))

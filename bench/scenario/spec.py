@@ -193,6 +193,18 @@ class Scenario:
         return tuple(v if t.max_thrust_N is None else t.max_thrust_N for t in self.thrusters)
 
     @property
+    def has_position_reference(self) -> bool:
+        """Whether the run has a position to hold or reach: a ``r_target_N_m``, or a
+        position expectation (band, steady-state, final or settling limit). Without one it
+        is an attitude-only run: its translation is reported as what the firing caused,
+        not as a position error."""
+        e = self.expectations
+        return self.r_target_N_m is not None or any(
+            x is not None for x in (e.position_band_m, e.steady_state_position_error_m_max,
+                                    e.final_position_error_m_max,
+                                    e.position_settling_time_s_max))
+
+    @property
     def r_reference_N_m(self) -> Vec3:
         """Reference position of the position metrics [m] (target, else the initial one)."""
         return self.r0_N_m if self.r_target_N_m is None else self.r_target_N_m

@@ -61,6 +61,9 @@ def test_second_bench_on_a_named_bus_is_refused_and_reported_by_both(
         _, err1 = p1.communicate(timeout=RUN_TIMEOUT_S)
     assert p2.returncode == EXIT_BAD_INPUT, err2
     assert "--bus" in err2 and "heard" in err2
+    s2 = json.loads((tmp_path / "second" / "summary.json").read_text(encoding="utf-8"))
+    assert s2["ended"] == "refused" and s2["verdict"].startswith("REFUSED")
+    assert s2["second_sender_heard"] and "heard" in s2["abnormal"][0]
     s1 = json.loads((tmp_path / "first" / "summary.json").read_text(encoding="utf-8"))
     assert s1["compromised"] is not None and "BENCH_STATUS" in s1["compromised"]["messages"]
     assert "second sender" in err1
