@@ -66,7 +66,7 @@ class Lockstep:
             n.check_fsw_alive()
             if k % FLUSH_EVERY_CYCLES == 0 and n.progress is not None:
                 n.progress(t_k / NS_PER_S, duration_s)
-            results.cycle_wall_ns.append(clock.now_ns() - cycle_wall0)
+            results.cycle_wall_ns.add(clock.now_ns() - cycle_wall0)
         wire.release()
         wire.flush()
         n._samples.clear()
@@ -125,7 +125,7 @@ class Lockstep:
                 n._events(events)
                 events = []
         n._second_sender()
-        results.fsw_wait_ns.append(n.clock.now_ns() - wait0)
+        results.fsw_wait_ns.add(n.clock.now_ns() - wait0)
         rx = wire.flush(ready_ns + n.period_ns)
         if any(g[1] not in rx for g in got):  # a congested wire: resolve what is left
             rx.update(wire.flush())

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+PROGRESS_BAR_WIDTH = 30  # characters of the terminal progress bar
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = REPO / "scenarios"
 CONTINUOUS = (
@@ -222,6 +223,19 @@ def copy_run_plots(rep: Reproduction, run_dirs: dict[str, Path], dest: Path) -> 
     return copied
 
 
+def show_progress(done: int, total: int, name: str, summary: dict[str, Any]) -> None:
+    """On stderr, as each run ends: a bar on a terminal; a flushed line when redirected
+    (a log, CI), so a many-minute benchmark shows its runs as they finish."""
+    verdict = summary.get("verdict") or ("PASS" if summary.get("passed") else "FAIL")
+    if sys.stderr.isatty():
+        n = done * PROGRESS_BAR_WIDTH // total
+        sys.stderr.write(f"\r[{'#' * n}{'.' * (PROGRESS_BAR_WIDTH - n)}] {done}/{total} "
+                         f"{name[:40]:40s}" + ("\n" if done == total else ""))
+    else:
+        sys.stderr.write(f"[{done}/{total}] {name}: {verdict}\n")
+    sys.stderr.flush()
+
+
 def main() -> None:
     """Parse arguments, run every reproduction and variant, print JSON."""
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -231,6 +245,8 @@ def main() -> None:
     args = p.parse_args()
     chosen = [r for r in REPRODUCTIONS if not args.only or r.name in args.only]
     result: dict[str, Any] = {"benchmark": "reproductions", "runs": {}}
+    total = sum(len(r.variants) for r in chosen)
+    done = 0
     with tempfile.TemporaryDirectory(prefix="thil-repro-") as tmp:
         root = Path(args.keep) if args.keep else Path(tmp)
         for rep in chosen:
@@ -241,6 +257,8 @@ def main() -> None:
                 summary = run_scenario(SCENARIOS / rep.scenario, sets, out)
                 result["runs"][f"{rep.name}/{variant}"] = figures(summary, out)
                 dirs[variant] = out
+                done += 1
+                show_progress(done, total, f"{rep.name}/{variant}", summary)
                 six_dof = six_dof or summary.get("position_band_m") is not None
             if args.plots:
                 dest = Path(args.plots).resolve()

@@ -6,6 +6,11 @@ channel of its own), all with the same seed, and reports per run its exit code, 
 passed, the channel it printed, and whether its ``telemetry.csv`` equals the run alone's
 byte for byte.
 
+``python benchmarks/shared_machine.py second [--repeats 5]`` starts a realtime run on a
+named hilbus channel and, once it runs, a second run on the same channel; it reports how
+long until the second was refused and until the first's console named a second sender
+(seconds from the second's start), and what each summary says.
+
 ``python benchmarks/shared_machine.py signals [--runs 20]`` starts ``--runs`` lockstep and
 ``--runs`` realtime quickstart runs one after the other, each in its own process group, and
 sends SIGTERM to the group at a random moment (seeded: ``--seed``) after the run reports
@@ -28,6 +33,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -152,6 +158,52 @@ def signals(runs: int, seed: int) -> dict[str, Any]:
             "per_run": rows}
 
 
+def _timestamped(stream: Any, into: list[tuple[float, str]]) -> None:
+    """Append each line of ``stream`` to ``into`` with the time it was read."""
+    for line in stream:
+        into.append((time.monotonic(), line))
+
+
+def second_bench(repeats: int) -> dict[str, Any]:
+    """A second run started on the named bus of a running one, ``repeats`` times: how long
+    until the second is refused and until the first's console names a second sender [s],
+    and whether both summaries say so."""
+    rows = []
+    for k in range(repeats):
+        scratch = Path(tempfile.mkdtemp(prefix="thil-2nd-"))
+        xdg = scratch / "xdg"
+        xdg.mkdir()
+        bus = f"hilbus:second{os.getpid()}x{k}"
+        first = _start(scratch / "first", xdg, ["--mode", "realtime", "--duration", "6",
+                                                "--bus", bus])
+        assert first.stderr is not None
+        lines: list[tuple[float, str]] = []
+        reader = threading.Thread(target=_timestamped, args=(first.stderr, lines), daemon=True)
+        reader.start()
+        while not any(ln.startswith(PROGRESS_MARK) for _, ln in lines):
+            if first.poll() is not None:
+                break
+            time.sleep(0.05)  # polling the reader thread's list
+        t0 = time.monotonic()
+        second = _start(scratch / "second", xdg, ["--bus", bus])
+        second.communicate(timeout=RUN_TIMEOUT_S)
+        refused_s = time.monotonic() - t0
+        first.wait(timeout=RUN_TIMEOUT_S)
+        reader.join(timeout=RUN_TIMEOUT_S)
+        told = [t for t, ln in lines if t >= t0 and "second sender" in ln]
+        s1, s2 = _summary(scratch / "first") or {}, _summary(scratch / "second") or {}
+        rows.append({
+            "second_exit_code": second.returncode, "second_refused_after_s": round(refused_s, 3),
+            "first_console_after_s": round(told[0] - t0, 3) if told else None,
+            "first_summary_compromised": (s1.get("compromised") or {}).get("messages"),
+            "second_summary_ended": s2.get("ended"), "second_heard": s2.get("second_sender_heard"),
+        })
+    return {"repeats": repeats, "per_run": rows,
+            "max_refused_after_s": max(r["second_refused_after_s"] for r in rows),
+            "max_first_console_after_s": max((r["first_console_after_s"] or float("inf"))
+                                             for r in rows)}
+
+
 def main(argv: list[str] | None = None) -> None:
     """Command line: print the JSON figures."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -161,8 +213,12 @@ def main(argv: list[str] | None = None) -> None:
     sp = sub.add_parser("signals", help="SIGTERM at a random moment")
     sp.add_argument("--runs", type=int, default=20, help="runs per mode (default 20)")
     sp.add_argument("--seed", type=int, default=SEED, help=f"moments' seed (default {SEED})")
+    sb = sub.add_parser("second", help="a second run on the named bus of a running one")
+    sb.add_argument("--repeats", type=int, default=5, help="times (default 5)")
     args = ap.parse_args(argv)
-    result = parallel(args.runs) if args.what == "parallel" else signals(args.runs, args.seed)
+    result = (parallel(args.runs) if args.what == "parallel"
+              else signals(args.runs, args.seed) if args.what == "signals"
+              else second_bench(args.repeats))
     print(json.dumps(result, indent=2))
 
 

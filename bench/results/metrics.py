@@ -12,13 +12,13 @@ from typing import Any
 
 import numpy as np
 
-from dbc.records import percentile_summary
+from dbc.records import Distribution, percentile_summary
 
 NS_PER_US = 1e3
 LATENCY_DIGITS = 3  # 1 ns in microseconds
 
 
-def latency_summary(samples_ns: Sequence[int]) -> dict[str, Any]:
+def latency_summary(samples_ns: Sequence[int] | Distribution) -> dict[str, Any]:
     """p50, p99, max in microseconds (1 ns resolution) and the sample count."""
     return percentile_summary(samples_ns, NS_PER_US, LATENCY_DIGITS)
 

@@ -15,7 +15,6 @@ Units: times in the files and the summary in seconds, latencies in microseconds.
 
 from __future__ import annotations
 
-from array import array
 from pathlib import Path
 from typing import Any
 
@@ -30,11 +29,12 @@ from bench.station.station import Pulse, Station
 from bench.wire.receipt import Receipt
 from bench.wire.wire import Wire
 from dbc.icd import BENCH, Icd
+from dbc.records import Distribution
 
 NAN = float("nan")
 NS_PER_S = 1_000_000_000
 NS_PER_MS = 1e6
-INT64 = "q"  # array type code of the per-cycle series
+MEASURED_QUANTUM_NS = 1000  # resolution kept of wall-clock measurements [ns]
 
 
 class Results:
@@ -50,11 +50,11 @@ class Results:
         self.fsw = FswView(icd)
         self._open_delay_ns = open_delay_ns
         self.imu_tx_ns: dict[int, int] = {}
-        # per control cycle, packed (8 bytes a value: a 2 h run's 360 000 cycles keep
-        # 2.9 MB a series, where Python ints in lists took four times that)
-        self.latency_ns: array[int] = array(INT64)
-        self.cycle_wall_ns: array[int] = array(INT64)
-        self.fsw_wait_ns: array[int] = array(INT64)
+        # per control cycle, as counts per value (memory in distinct values, not cycles):
+        # modelled lockstep latencies exact to the ns, wall-clock measures to the us
+        self.latency_ns = Distribution(1 if mode == "lockstep" else MEASURED_QUANTUM_NS)
+        self.cycle_wall_ns = Distribution(MEASURED_QUANTUM_NS)
+        self.fsw_wait_ns = Distribution(MEASURED_QUANTUM_NS)
         self.stalls = 0
         self.late_steps = 0
         self.max_lag_ns = 0
@@ -76,7 +76,7 @@ class Results:
         """
         t_imu = self.imu_tx_ns.get(imu_counter)
         if t_imu is not None:
-            self.latency_ns.append(t_cmd_ns - t_imu)
+            self.latency_ns.add(t_cmd_ns - t_imu)
         t_fire = NAN if t_fire_ns is None else t_fire_ns / NS_PER_S
         t_open = NAN if t_fire_ns is None else (t_fire_ns + self._open_delay_ns) / NS_PER_S
         self.chains.row([cycle, imu_counter, NAN if t_imu is None else t_imu / NS_PER_S,
