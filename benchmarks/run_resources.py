@@ -9,10 +9,11 @@ with the simulated time reached (the last row of ``telemetry.csv``). It prints o
 object per run:
 
 - ``rss_mb``: per process, the RSS at the first sample at or after ``--from-s`` simulated
-  seconds (default 60), at the last sample taken while the simulation still advanced
-  (``at_end_of_sim``: before the end-of-run work, summary and plots), the growth between
-  these two, and the highest RSS (VmHWM, the kernel's own high-water mark, so a short
-  peak between two samples is counted too, the end-of-run work's included);
+  seconds (default 60), at the last sample taken while the simulation still advanced and
+  before :data:`IN_RUN_FRACTION` of the duration (``at_end_of_sim``: the run loop, not the
+  end-of-run work of summary and plots, which flushes the last telemetry rows), the growth
+  between these two, and the highest RSS (VmHWM, the kernel's own high-water mark, so a
+  short peak between two samples is counted too, the end-of-run work's included);
 - ``peak_rss_mb_any_process``: the largest RSS any process of the run reached, from the
   kernel's accounting of the waited-for descendants (``getrusage(RUSAGE_CHILDREN)``);
 - ``folder``: the run folder's size and its bytes per simulated second, per file too;
@@ -42,6 +43,7 @@ KB_PER_MB = 1024.0
 BYTES_PER_KB = 1024.0
 TAIL_BYTES = 4096  # enough to hold the last telemetry row
 ROLES = ("supervisor", "bench", "flight_sw")
+IN_RUN_FRACTION = 0.99  # samples past this share of the duration may be the end-of-run work
 
 
 def _status_kb(pid: int, field: str) -> float | None:
@@ -132,7 +134,7 @@ def measure(scenario: Path, duration_s: float, from_s: float, every_s: float,
             rss, peak = _status_kb(pid, "VmRSS"), _status_kb(pid, "VmHWM")
             if rss is None or peak is None:
                 continue
-            if t_sim >= from_s and advancing:
+            if from_s <= t_sim < IN_RUN_FRACTION * duration_s and advancing:
                 first.setdefault(role, rss)
                 last[role] = rss
             hwm[role] = max(hwm.get(role, 0.0), peak)

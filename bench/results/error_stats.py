@@ -6,7 +6,8 @@ position error [m]. Out (:meth:`ErrorStats.pointing`, :meth:`ErrorStats.position
 :meth:`SettlingTracker.settling_time_s`): settling times, convergence, steady-state and
 final errors, the figures ``summary.json`` reports (bench.results.summary).
 
-Definitions (project convention, as in every seed paper's settling-time figure):
+Definitions (project convention; the settling time is the one the seed papers quote, read
+from the error history):
 - the settling time of a series in a band is ``t_j - t_start`` where ``j`` is the sample
   after the last one outside the band (error > band); 0 if no sample was outside; None
   (not settled) if the last sample is outside or there is no sample;
