@@ -49,6 +49,7 @@ class Lockstep:
         n.started = True
         n.trace.event(0, "run_started", mode=n.mode, seed=n.seed, cycles=n_cycles)
         clock, wire, results = n.clock, n.wire, n.results
+        results.lockstep_spin_s = n.lockstep_spin_s
         wall0 = clock.now_ns()
         n._start()
         for k in range(n_cycles):
@@ -61,11 +62,8 @@ class Lockstep:
             n._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S}, max(t_k, wire.last_rx_ns))
             wire.release()
             wire.flush()
-            self._collect(k, wire.last_rx_ns + delay_ns)
+            self._collect(k, wire.last_rx_ns + delay_ns, duration_s)
             n.integrate_to(t_k + period)
-            n.check_fsw_alive()
-            if k % FLUSH_EVERY_CYCLES == 0 and n.progress is not None:
-                n.progress(t_k / NS_PER_S, duration_s)
             results.cycle_wall_ns.add(clock.now_ns() - cycle_wall0)
         wire.release()
         wire.flush()
@@ -73,7 +71,7 @@ class Lockstep:
         results.wall_s = (clock.now_ns() - wall0) / NS_PER_S
         n.trace.event(n.station.t_ns, "run_finished", stalls=results.stalls)
 
-    def _collect(self, k: int, ready_ns: int) -> None:
+    def _collect(self, k: int, ready_ns: int, duration_s: float) -> None:
         """Receive cycle k's commands and deliver them at their modelled arrival."""
         n = self.node
         st, wire, results = n.station, n.wire, n.results
@@ -88,9 +86,12 @@ class Lockstep:
         if k % FLUSH_EVERY_CYCLES == 0:
             n.trace.flush()
             results.flush()
+            if n.progress is not None:
+                n.progress(k * n.period_ns / NS_PER_S, duration_s)
+        n.check_fsw_alive()  # here, not after the cycle: its poll is off the critical path
         got: list[tuple[int, int, dict[str, float], int]] = []  # (frame, seq, signals, delay)
         lost = 0  # command frames that injected faults kept from the bench this cycle
-        fsw_dead = n.fsw_alive is not None and not n.fsw_alive()
+        fsw_dead = n.fsw_exit_ns is not None
         timeout_ns = (0 if (st.fsw_silent or fsw_dead)
                       else round(n.sc.bus.stall_timeout_s * NS_PER_S))
         wait0 = n.clock.now_ns()

@@ -28,8 +28,8 @@ Sources: ISO 11898-1:2015 (error frames §10.4.4, fault confinement §12.1.4).
 from __future__ import annotations
 
 import heapq
-from dataclasses import dataclass
 from operator import itemgetter
+from typing import Final, final
 
 from bench.wire.timing.classic import (
     ACK_DELIMITER_BITS,
@@ -76,23 +76,46 @@ def bus_off_recovery_ns(bitrate_bps: int) -> int:
 # -- arbitration ----------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@final
 class Delivery:
     """When one frame was on the wire.
 
     ``start_ns``/``end_ns`` bound the successful attempt (``end_ns`` includes the
     intermission). ``failed_ns`` lists the [start, end) of each failed attempt, error frame
     and intermission included; ``attempts`` = len(failed_ns) + 1.
+
+    A plain class with ``Final`` fields, not a frozen dataclass: one is made per frame on
+    the wire, and a frozen dataclass's generated ``__init__`` (``object.__setattr__`` per
+    field, interpreted even in the compiled module) cost ~2.7 us each, ~40x this one.
+    Equal by value, like the dataclass it replaces.
     """
 
-    ready_ns: int
-    start_ns: int
-    end_ns: int
-    can_id: int
-    seq: int
-    attempts: int = 1
-    node: str = ""
-    failed_ns: tuple[tuple[int, int], ...] = ()
+    def __init__(self, ready_ns: int, start_ns: int, end_ns: int, can_id: int, seq: int,
+                 attempts: int = 1, node: str = "",
+                 failed_ns: tuple[tuple[int, int], ...] = ()) -> None:
+        self.ready_ns: Final = ready_ns
+        self.start_ns: Final = start_ns
+        self.end_ns: Final = end_ns
+        self.can_id: Final = can_id
+        self.seq: Final = seq
+        self.attempts: Final = attempts
+        self.node: Final = node
+        self.failed_ns: Final = failed_ns
+
+    def _key(self) -> tuple[int, int, int, int, int, int, str, tuple[tuple[int, int], ...]]:
+        return (self.ready_ns, self.start_ns, self.end_ns, self.can_id, self.seq,
+                self.attempts, self.node, self.failed_ns)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Delivery) and self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        return (f"Delivery(ready_ns={self.ready_ns}, start_ns={self.start_ns}, "
+                f"end_ns={self.end_ns}, can_id={self.can_id}, seq={self.seq}, "
+                f"attempts={self.attempts}, node={self.node!r}, failed_ns={self.failed_ns})")
 
     @property
     def first_start_ns(self) -> int:

@@ -28,6 +28,7 @@ known answers of the tests).
 from __future__ import annotations
 
 import functools
+from typing import Final
 
 NS_PER_S = 1_000_000_000
 BITS_PER_BYTE = 8
@@ -38,7 +39,7 @@ SOF_BITS = 1
 BASE_ID_BITS = 11
 EXT_ID_BITS = 18  # identifier extension of a 29-bit ID
 DLC_BITS = 4
-CRC15_BITS = 15
+CRC15_BITS: Final = 15
 CRC15_POLY = 0x4599
 CRC_DELIMITER_BITS = 1
 ACK_SLOT_BITS = 1
@@ -47,7 +48,7 @@ EOF_BITS = 7
 INTERMISSION_BITS = 3
 CAN_MAX_DATA_BYTES = 8
 FLAG_BITS = 1  # each one-bit field: RTR, SRR, IDE, r0, r1, FDF, res, RRS, BRS, ESI
-UNSTUFFED_TAIL_BITS = (  # CRC delimiter, ACK slot + delimiter, EOF, intermission = 13
+UNSTUFFED_TAIL_BITS: Final = (  # CRC delimiter, ACK slot + delimiter, EOF, intermission = 13
     CRC_DELIMITER_BITS + ACK_SLOT_BITS + ACK_DELIMITER_BITS + EOF_BITS + INTERMISSION_BITS
 )
 # bits SOF..DLC ("header", Linux CAN_FRAME_HEADER_*_BITS): SFF = SOF, ID, RTR, IDE, r0, DLC
@@ -115,7 +116,7 @@ def _crc15_table() -> tuple[int, ...]:
     return tuple(table)
 
 
-_CRC15_TABLE = _crc15_table()
+_CRC15_TABLE: Final = _crc15_table()
 
 
 # Bit-stuffing as a state machine over whole bytes: state = 5 * last_bit + run (run =
@@ -152,6 +153,18 @@ _STUFF8 = _stuff_tables(8)
 _STUFF7 = _stuff_tables(7)
 
 
+def _flat(tables: tuple[tuple[tuple[int, int], ...], ...], width: int) -> tuple[int, ...]:
+    """The same table flat, for the per-frame loop: entry ``(state << width) | value`` is
+    ``(state' << STUFF_COUNT_BITS) | stuffs`` (one integer lookup instead of two tuples)."""
+    return tuple((st << STUFF_COUNT_BITS) | n for row in tables for st, n in row)
+
+
+STUFF_COUNT_BITS: Final = 4  # stuff bits of one chunk of <= 8 bits: at most 2, held in 4 bits
+STUFF_COUNT_MASK: Final = (1 << STUFF_COUNT_BITS) - 1
+_FLAT8: Final = _flat(_STUFF8, 8)
+_FLAT7: Final = _flat(_STUFF7, 7)
+
+
 @functools.lru_cache(maxsize=4096)
 def _header(can_id: int, dlc: int, extended: bool, remote: bool) -> tuple[int, int, int, int]:
     """(bits, CRC-15 register, stuffing state, stuff bits) after SOF..DLC of a frame."""
@@ -178,16 +191,17 @@ def frame_bits(can_id: int, data: bytes, extended: bool = False, remote: bool = 
     dlc = len(data)
     n_bits, crc, state, stuff = _header(can_id, dlc, extended, remote)
     if not remote:
-        t8 = _STUFF8
+        t8, table = _FLAT8, _CRC15_TABLE
         for byte in data:
-            crc = ((crc << 8) & 0x7FFF) ^ _CRC15_TABLE[((crc >> 7) ^ byte) & 0xFF]
-            state, k = t8[state][byte]
-            stuff += k
+            crc = ((crc << 8) & 0x7FFF) ^ table[((crc >> 7) ^ byte) & 0xFF]
+            entry = t8[(state << 8) | byte]
+            state = entry >> STUFF_COUNT_BITS
+            stuff += entry & STUFF_COUNT_MASK
         n_bits += 8 * dlc
-    state, k = _STUFF8[state][crc >> 7]  # CRC-15: its top 8 bits, then the low 7
-    stuff += k
-    state, k = _STUFF7[state][crc & 0x7F]
-    stuff += k
+    entry = _FLAT8[(state << 8) | (crc >> 7)]  # CRC-15: its top 8 bits, then the low 7
+    stuff += entry & STUFF_COUNT_MASK
+    entry = _FLAT7[((entry >> STUFF_COUNT_BITS) << 7) | (crc & 0x7F)]
+    stuff += entry & STUFF_COUNT_MASK
     return n_bits + CRC15_BITS + stuff + UNSTUFFED_TAIL_BITS
 
 
