@@ -31,6 +31,7 @@ from mypy_extensions import mypyc_attr
 
 from bench.lockstep import Lockstep
 from bench.realtime import Realtime
+from bench.results.record import RECORD_STANDARD
 from bench.results.run import Results
 from bench.results.telemetry import TELEMETRY_PERIOD_NS
 from bench.results.writers import write_summary
@@ -78,8 +79,10 @@ class BenchNode:
                  seed: int, bus_spec: str,
                  progress: Callable[[float, float], None] | None = None,
                  clock: Clock | None = None,
-                 realtime_loop: type[Realtime] = Realtime) -> None:
-        """``realtime_loop``: the realtime loop's class (tests instrument it by subclassing)."""
+                 realtime_loop: type[Realtime] = Realtime,
+                 record: str = RECORD_STANDARD) -> None:
+        """``realtime_loop``: the realtime loop's class (tests instrument it by subclassing);
+        ``record``: how the run folder's trace and tables are written (bench.results.record)."""
         self.sc, self.db, self.bus, self.run_dir = sc, db, bus, run_dir
         self.mode, self.seed, self.bus_spec, self.progress = mode, seed, bus_spec, progress
         self.realtime_loop = realtime_loop
@@ -93,7 +96,7 @@ class BenchNode:
         self.plant = self.station.plant
         self.n_thr = len(sc.thrusters)
         self.cmd_frames = icd.command_frames_for(self.n_thr)
-        self.trace = TraceRecorder(run_dir, self.clock.wall0_s, lockstep)
+        self.trace = TraceRecorder(run_dir, self.clock.wall0_s, lockstep, record)
         rng = np.random.default_rng(np.random.SeedSequence([seed, FAULT_RNG_STREAM]))
         faults = self.station.faults
 
@@ -106,7 +109,7 @@ class BenchNode:
                                own=icd.sent_by(BENCH))
         self.receipt = Receipt(icd, checker, rng, self.wire.fault_counts, active)
         self.results = Results(sc, icd, run_dir, mode, seed, bus_spec, self.n_thr,
-                               round(sc.valve.open_delay_s * NS_PER_S))
+                               round(sc.valve.open_delay_s * NS_PER_S), record)
         self.lockstep_spin_s = 0.0  # poll this long before blocking (transport.lockstep)
         self.fsw_alive: Callable[[], bool] | None = None
         self.fsw_exit_ns: int | None = None  # when the flight-software process was found gone

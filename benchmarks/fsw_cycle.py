@@ -40,6 +40,7 @@ from typing import Any
 
 import numpy as np
 
+from bench.results.record import read_lines, run_file
 from flight_sw.config import build_computer
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -90,8 +91,8 @@ def hot_cycle_us(
     """
     cfg = json.loads((run_dir / "fsw_config.json").read_text(encoding="utf-8"))
     fc = build_computer(cfg, CONTROL_PERIOD_NS, IMU_PERIOD_NS, WATCH_PERIODS_NS)
-    with (run_dir / "telemetry.csv").open(newline="", encoding="utf-8") as f:
-        rows = list(csv.DictReader(f))[::TELEMETRY_ROWS_PER_CYCLE][:max_cycles]
+    rows = list(csv.DictReader(read_lines(run_file(run_dir, "telemetry.csv"))))
+    rows = rows[::TELEMETRY_ROWS_PER_CYCLE][:max_cycles]
     times = []
     for k, row in enumerate(rows):
         t_ns = k * CONTROL_PERIOD_NS

@@ -25,6 +25,8 @@ import uuid
 from pathlib import Path
 from typing import Any
 
+from bench.results.record import read_lines, run_file
+
 REPO = Path(__file__).resolve().parents[1]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
 RATE_HZ = 20_000.0
@@ -64,7 +66,7 @@ def _run(work: Path, name: str, duration_s: float, frames: int,
     run.communicate()
     s = json.loads((out / "summary.json").read_text())
     return {"summary": s, "sent": sent, "wall_s": round(time.monotonic() - t0, 2),
-            "telemetry": (out / "telemetry.csv").read_bytes()}
+            "telemetry": "".join(read_lines(run_file(out, "telemetry.csv")))}
 
 
 def main() -> None:

@@ -30,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from bench.results.record import read_lines, run_file
+
 PROGRESS_BAR_WIDTH = 30  # characters of the terminal progress bar
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = REPO / "scenarios"
@@ -164,8 +166,7 @@ def figures(summary: dict[str, Any], run_dir: Path) -> dict[str, Any]:
 
 def read_telemetry(run_dir: Path) -> dict[str, np.ndarray]:
     """Columns of ``telemetry.csv`` as float arrays (non-numeric columns skipped)."""
-    with (run_dir / "telemetry.csv").open(newline="", encoding="utf-8") as f:
-        rows = list(csv.DictReader(f))
+    rows = list(csv.DictReader(read_lines(run_file(run_dir, "telemetry.csv"))))
     cols: dict[str, np.ndarray] = {}
     for key in rows[0] if rows else []:
         try:
@@ -184,7 +185,8 @@ def plot_comparison(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    tel = {v: read_telemetry(d) for v, d in run_dirs.items() if (d / "telemetry.csv").exists()}
+    tel = {v: read_telemetry(d) for v, d in run_dirs.items()
+           if run_file(d, "telemetry.csv").exists()}
     if not tel:
         return []
     fig, axes = plt.subplots(2 if six_dof else 1, 1, figsize=(8, 6 if six_dof else 3.5),

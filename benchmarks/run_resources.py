@@ -5,7 +5,8 @@
 channel and in a scratch run folder, and samples every ``--every`` wall seconds, from
 ``/proc``, the resident memory (VmRSS) of each process of the run: the supervisor (the
 command), the bench (its child) and the flight software (the bench's child), together
-with the simulated time reached (the last row of ``telemetry.csv``). It prints one JSON
+with the simulated time reached (the last row of ``telemetry.csv``, or of the default
+compressed ``telemetry.csv.gz``, followed as it grows). It prints one JSON
 object per run:
 
 - ``rss_mb``: per process, the RSS at the first sample at or after ``--from-s`` simulated
@@ -34,6 +35,7 @@ import sys
 import tempfile
 import time
 import uuid
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +43,7 @@ REPO = Path(__file__).resolve().parents[1]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
 KB_PER_MB = 1024.0
 BYTES_PER_KB = 1024.0
-TAIL_BYTES = 4096  # enough to hold the last telemetry row
+GZIP_WBITS = 16 + 15  # zlib: a gzip stream, 32 KiB window
 ROLES = ("supervisor", "bench", "flight_sw")
 IN_RUN_FRACTION = 0.99  # samples past this share of the duration may be the end-of-run work
 
@@ -81,22 +83,45 @@ def _tree(root: int) -> dict[str, int]:
     return roles
 
 
-def _sim_time_s(telemetry: Path) -> float:
-    """The simulated time of the last complete row of ``telemetry.csv`` (0 before one)."""
-    try:
-        with open(telemetry, "rb") as f:
-            f.seek(0, os.SEEK_END)
-            size = f.tell()
-            f.seek(max(0, size - TAIL_BYTES))
-            lines = f.read().split(b"\n")
-    except OSError:
-        return 0.0
-    for line in reversed(lines[:-1]):  # the part after the last newline may be incomplete
+class TelemetryTail:
+    """The simulated time of the last complete row of a run's telemetry, followed as the
+    file grows: plain ``telemetry.csv`` or the default compressed ``telemetry.csv.gz``
+    (decompressed incrementally, only what was added since the last look)."""
+
+    def __init__(self, run_dir: Path) -> None:
+        self.run_dir = run_dir
+        self.path: Path | None = None
+        self.offset = 0
+        self.unpack: Any = None
+        self.rest = b""  # text after the last newline seen (an incomplete row)
+        self.t_s = 0.0
+
+    def sim_time_s(self) -> float:
+        """The time of the newest complete row (0 before one)."""
+        if self.path is None:
+            for name in ("telemetry.csv", "telemetry.csv.gz"):
+                if (self.run_dir / name).exists():
+                    self.path = self.run_dir / name
+                    self.unpack = zlib.decompressobj(GZIP_WBITS) if name.endswith(".gz") else None
+            if self.path is None:
+                return 0.0
         try:
-            return float(line.split(b",", 1)[0])
-        except ValueError:
-            continue
-    return 0.0
+            with open(self.path, "rb") as f:
+                f.seek(self.offset)
+                data = f.read()
+        except OSError:
+            return self.t_s
+        self.offset += len(data)
+        text = self.rest + (self.unpack.decompress(data) if self.unpack is not None else data)
+        lines = text.split(b"\n")
+        self.rest = lines[-1]
+        for line in reversed(lines[:-1]):
+            try:
+                self.t_s = float(line.split(b",", 1)[0])
+                break
+            except ValueError:
+                continue
+        return self.t_s
 
 
 def _folder(out: Path, duration_s: float) -> dict[str, Any]:
@@ -126,8 +151,9 @@ def measure(scenario: Path, duration_s: float, from_s: float, every_s: float,
     last: dict[str, float] = {}
     hwm: dict[str, float] = {}
     t_before = -1.0
+    tail = TelemetryTail(out)
     while p.poll() is None:
-        t_sim = _sim_time_s(out / "telemetry.csv")
+        t_sim = tail.sim_time_s()
         advancing = t_sim > t_before
         t_before = t_sim
         for role, pid in _tree(p.pid).items():
@@ -145,7 +171,7 @@ def measure(scenario: Path, duration_s: float, from_s: float, every_s: float,
     def mb(kb: float | None) -> float | None:
         return None if kb is None else round(kb / KB_PER_MB, 1)
 
-    rss = {role: {"at_from_s": mb(first.get(role)), "at_end_of_sim": mb(last.get(role)),
+    rss_mb = {role: {"at_from_s": mb(first.get(role)), "at_end_of_sim": mb(last.get(role)),
                   "growth": mb(last[role] - first[role]) if role in first else None,
                   "highest": mb(hwm.get(role))} for role in ROLES}
     result = {
@@ -154,7 +180,7 @@ def measure(scenario: Path, duration_s: float, from_s: float, every_s: float,
         "exit_code": p.returncode,
         "wall_s": round(wall_s, 1),
         "realtime_factor": round(duration_s / wall_s, 1),
-        "rss_mb": rss,
+        "rss_mb": rss_mb,
         "peak_rss_mb_any_process": mb(children_peak_kb),
         "folder": _folder(out, duration_s) if out.is_dir() else None,
     }

@@ -38,6 +38,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bench.results.record import read_lines, run_file
+
 REPO = Path(__file__).resolve().parents[1]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
 CHANNEL_MARK = "thruster-hil: bus "  # the console line naming a run's own channel
@@ -49,6 +51,12 @@ DURATIONS_S = {"lockstep": 60.0, "realtime": 8.0}
 # the moment of the signal after the first progress line [s of wall time]
 SIGNAL_WINDOW_S = {"lockstep": 2.5, "realtime": 6.0}
 
+
+
+def _telemetry(run_dir: Path) -> str | None:
+    """The text of a run's telemetry, plain or compressed (None if it has none)."""
+    path = run_file(run_dir, "telemetry.csv")
+    return "".join(read_lines(path)) if path.exists() else None
 
 def _start(out: Path, xdg: Path, extra: list[str], group: bool = False) -> subprocess.Popen[str]:
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
@@ -82,7 +90,7 @@ def parallel(runs: int) -> dict[str, Any]:
     alone = _start(scratch / "alone", xdg, [])
     alone.communicate(timeout=RUN_TIMEOUT_S)
     alone_s = time.monotonic() - t0
-    reference = (scratch / "alone" / "telemetry.csv").read_bytes()
+    reference = _telemetry(scratch / "alone")
     t0 = time.monotonic()
     procs = [_start(scratch / f"p{i}", xdg, []) for i in range(runs)]
     rows = []
@@ -90,10 +98,9 @@ def parallel(runs: int) -> dict[str, Any]:
         _, err = p.communicate(timeout=RUN_TIMEOUT_S)
         out = scratch / f"p{i}"
         s = _summary(out) or {}
-        tel = out / "telemetry.csv"
         rows.append({"exit_code": p.returncode, "passed": s.get("passed"),
                      "channel": _channel(err),
-                     "telemetry_equals_alone": tel.exists() and tel.read_bytes() == reference,
+                     "telemetry_equals_alone": _telemetry(out) == reference,
                      "realtime_factor": s.get("realtime_factor")})
     return {
         "runs": runs, "alone": {"exit_code": alone.returncode, "wall_s": round(alone_s, 1)},

@@ -22,6 +22,7 @@ from typing import Any
 
 from bench.operator.lifecycle import Stopped
 from bench.operator.verdict import abnormal, verdict
+from bench.results.record import RECORD_CHOICES, RECORD_STANDARD
 from dbc import options as opt
 from dbc.datafile import parse_json, read_text
 from dbc.errors import BusError, ConfigError, IcdError, RunError
@@ -138,6 +139,7 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         duration_s=args.duration if args.duration is not None else sc.duration_s,
         fsw_cmd=None if alone else (args.fsw_cmd or DEFAULT_FSW_CMD),
         bus_shared=args.bus is not None,
+        record=args.record,
     )
     opts = dataclasses.replace(opts, out=prepare_run_folder(Path(args.out), args.replace)
                                if args.out else default_run_folder(sc.name))
@@ -285,6 +287,11 @@ def build_parser() -> argparse.ArgumentParser:
         r.add_argument("--out", type=opt.text("--out", "a folder path"),
                        help="run folder, new or empty (default: runs/<scenario>-<time>-<hex>, "
                        "a new folder)")
+        r.add_argument("--record", type=opt.choice("--record", RECORD_CHOICES),
+                       default=RECORD_STANDARD, metavar="{standard,full}",
+                       help="standard: the CAN trace and the CSV tables gzip-compressed "
+                       "(trace.asc.gz, telemetry.csv.gz, ...: about a fifth of the size); "
+                       "full: the same files as plain text (default standard)")
         r.add_argument("--replace", action="store_true",
                        help="let --out name a folder holding an earlier run, which is deleted")
         r.add_argument("--duration", type=opt.number("--duration", control_period_s,

@@ -8,7 +8,8 @@ statistics JSON), ``{rx_log}`` (where it may log when each frame arrived, realti
 ``fsw_rx.csv``, see :mod:`bench.operator.analysis.reception`) and ``{run_dir}``. The run folder
 always ends up with ``summary.json``, ``trace.asc``, ``telemetry.csv``,
 ``valve_pulses.csv``, ``events.jsonl``, ``fsw.log`` and the PNG plots, even when the flight
-software dies.
+software dies (the trace and the tables with ``.gz`` added at the default ``--record
+standard``: bench.results.record).
 """
 
 from __future__ import annotations
@@ -47,6 +48,7 @@ from bench.operator.run_warnings import (
 from bench.operator.shared_bus import probe
 from bench.operator.verdict import abnormal, verdict
 from bench.results.counts import merge_counts, zero_unheard
+from bench.results.record import RECORD_STANDARD, check_record
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
 from dbc.codec import cycle_time_ns
@@ -73,10 +75,12 @@ class RunOptions:
     duration_s: float
     fsw_cmd: str | None = DEFAULT_FSW_CMD  # None: bench alone (external flight software)
     bus_shared: bool = False  # a bus the user named: another run may be on it (probed)
+    record: str = RECORD_STANDARD  # bench.results.record: compressed or plain files
 
     def __post_init__(self) -> None:
         if self.mode not in ("lockstep", "realtime"):
             raise ConfigError("command line", "--mode", self.mode, "lockstep or realtime")
+        check_record(self.record)
         period_s = cycle_time_ns(load_database(), "THR_CMD_0") / 1e9
         if not self.duration_s >= period_s:  # also rejects NaN
             raise ConfigError("command line", "--duration", self.duration_s,
@@ -195,7 +199,8 @@ def _run_bench(
     db = load_database()
     bus = open_bus(opts.bus, **mode_options(opts.bus, opts.mode))
     proc: subprocess.Popen[bytes] | None = None
-    node = BenchNode(sc, db, bus, out, opts.mode, opts.seed, opts.bus, progress)
+    node = BenchNode(sc, db, bus, out, opts.mode, opts.seed, opts.bus, progress,
+                     record=opts.record)
     node.trace.listener = alert
     node.lockstep_spin_s = spin_s
     if ready is not None:

@@ -1,8 +1,10 @@
 """summary.json rebuilt from the files a killed bench left behind (flushed as it ran).
 
 In: the run folder's ``telemetry.csv``, ``frames.csv``, ``events.jsonl`` and the flight
-software's statistics. Out: a summary marked ``partial`` with the error that ended the
-run, the pointing metrics of what was recorded, the frame counts and the faults seen.
+software's statistics (plain or ``.gz``; compressed files the bench left without their
+gzip trailer are sealed first, bench.results.record.seal, and named in ``files_sealed``).
+Out: a summary marked ``partial`` with the error that ended the run, the pointing metrics
+of what was recorded, the frame counts and the faults seen.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from bench.operator.fsw_process import fsw_report, wait_for_exit
 from bench.operator.verdict import abnormal, verdict
 from bench.results.counts import frame_table, merge_counts, zero_unheard
 from bench.results.error_stats import ErrorStats
+from bench.results.record import GZ_SUFFIX, read_lines, run_file, seal
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
 from dbc.database import load_database
@@ -41,11 +44,13 @@ def partial_summary(
     """
     out = opts.out
     wait_for_exit(out)
+    # the killed bench left its compressed files without a gzip trailer: make them whole
+    sealed = [p.name for p in sorted(out.glob("*" + GZ_SUFFIX)) if seal(p)]
     db = load_database()
     errors = ErrorStats(sc.expectations.settling_band_deg,
                         sc.expectations.steady_state_window_s, sc.manoeuvre_start_s)
     t_last_s, propellant_kg = 0.0, 0.0
-    for row in _numeric_rows(out / "telemetry.csv",
+    for row in _numeric_rows(run_file(out, "telemetry.csv"),
                              ("t_s", "att_err_deg", "rate_err_deg_s", "propellant_kg")):
         t_last_s, att, rate, propellant_kg = row
         if t_last_s >= sc.manoeuvre_start_s:  # as the bench's own figures (telemetry.py)
@@ -55,7 +60,7 @@ def partial_summary(
     name_of = {m.frame_id: m.name for m in db.messages}
     sent: dict[str, int] = {}
     received: dict[str, dict[str, Any]] = {}
-    for can_id, tx in _numeric_rows(out / "frames.csv", ("id", "tx")):
+    for can_id, tx in _numeric_rows(run_file(out, "frames.csv"), ("id", "tx")):
         name = name_of.get(int(can_id))
         if name is None:
             continue
@@ -78,7 +83,8 @@ def partial_summary(
                 faults.append(ev)
     summary: dict[str, Any] = {
         "scenario": sc.name, "scenario_file": sc.path, "mode": opts.mode, "seed": opts.seed,
-        "bus": opts.bus, "sim_time_s": t_last_s, "wall_time_s": None,
+        "record": opts.record, "files_sealed": sealed, "bus": opts.bus,
+        "sim_time_s": t_last_s, "wall_time_s": None,
         "realtime_factor": None, "converged": pm.converged, "settling_time_s": pm.settling_time_s,
         "steady_state_attitude_error_deg": pm.steady_state_attitude_error_deg,
         "steady_state_rate_error_deg_s": pm.steady_state_rate_error_deg_s,
@@ -106,16 +112,16 @@ def _numeric_rows(path: Path, columns: tuple[str, ...]) -> Iterator[list[float]]
     not numbers, is skipped. Nothing if the file or a column is missing."""
     if not path.exists():
         return
-    with open(path, encoding="utf-8") as f:
-        head = f.readline().rstrip("\n").split(",")
-        if any(c not in head for c in columns):
-            return
-        index = [head.index(c) for c in columns]
-        for line in f:
-            parts = line.rstrip("\n").split(",")
-            if len(parts) != len(head):
-                continue
-            try:
-                yield [float(parts[i]) for i in index]
-            except ValueError:
-                continue
+    lines = read_lines(path)
+    head = next(lines, "").rstrip("\n").split(",")
+    if any(c not in head for c in columns):
+        return
+    index = [head.index(c) for c in columns]
+    for line in lines:
+        parts = line.rstrip("\n").split(",")
+        if len(parts) != len(head):
+            continue
+        try:
+            yield [float(parts[i]) for i in index]
+        except ValueError:
+            continue

@@ -22,6 +22,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from bench.results.record import read_lines, run_file
+
 RAD_DEG = 180.0 / np.pi
 DPI = 110
 ERROR_FLOOR_DEG = 1e-4
@@ -38,20 +40,20 @@ def _read_columns(path: Path, wanted: tuple[str, ...]) -> tuple[list[str], dict[
     line cut short (a killed run's last) or not numeric is skipped. ({} if no file.)"""
     if not path.exists():  # a run refused or killed before its first row
         return [], {}
-    with open(path, encoding="utf-8") as f:
-        head = f.readline().rstrip("\n").split(",")
-        index = {c: head.index(c) for c in wanted if c in head}
-        cols: dict[str, array[float]] = {c: array(FLOAT64) for c in index}
-        for line in f:
-            parts = line.rstrip("\n").split(",")
-            if len(parts) != len(head):
-                continue
-            try:
-                values = [float(parts[i]) for i in index.values()]
-            except ValueError:
-                continue
-            for col, v in zip(cols.values(), values, strict=True):
-                col.append(v)
+    lines = read_lines(path)
+    head = next(lines, "").rstrip("\n").split(",")
+    index = {c: head.index(c) for c in wanted if c in head}
+    cols: dict[str, array[float]] = {c: array(FLOAT64) for c in index}
+    for line in lines:
+        parts = line.rstrip("\n").split(",")
+        if len(parts) != len(head):
+            continue
+        try:
+            values = [float(parts[i]) for i in index.values()]
+        except ValueError:
+            continue
+        for col, v in zip(cols.values(), values, strict=True):
+            col.append(v)
     return head, {c: np.frombuffer(a, dtype=float) if len(a) else np.zeros(0)
                   for c, a in cols.items()}
 
@@ -79,7 +81,7 @@ def envelope(t: np.ndarray, y: np.ndarray,
 
 def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
     """Draw every plot of ``run_dir``; returns the written paths."""
-    head, tel = _read_columns(run_dir / "telemetry.csv", TELEMETRY_COLUMNS)
+    head, tel = _read_columns(run_file(run_dir, "telemetry.csv"), TELEMETRY_COLUMNS)
     out: list[Path] = []
     if not tel or len(tel["t_s"]) == 0:
         return out
@@ -120,7 +122,7 @@ def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
     plt.close(fig)
 
     n_thr = sum(1 for k in head if k.startswith("thrust_T"))
-    _, pulses = _read_columns(run_dir / "valve_pulses.csv", PULSE_COLUMNS)
+    _, pulses = _read_columns(run_file(run_dir, "valve_pulses.csv"), PULSE_COLUMNS)
     fig, ax = plt.subplots(figsize=(8, 0.35 * max(n_thr, 4) + 1.2))
     if pulses and len(pulses.get("t_on_s", [])):
         for k in range(n_thr):

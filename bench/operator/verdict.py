@@ -81,6 +81,8 @@ def abnormal(s: dict[str, Any]) -> list[str]:
         out.append(f"stopped by {ended} at {s.get('sim_time_s', 0.0):.2f} s simulated")
     if s.get("error"):
         out.append(f"run error: {s['error']}")
+    if s.get("files_sealed"):
+        out.append("files left unfinished by the bench, sealed: " + ", ".join(s["files_sealed"]))
     comp = s.get("compromised")
     if comp:
         out.append("compromised: another node sent " + ", ".join(comp.get("messages", [])))

@@ -21,6 +21,7 @@ from typing import Any
 from bench.results.counts import frame_table, merge_counts
 from bench.results.fsw_view import FswView
 from bench.results.metrics import latency_summary
+from bench.results.record import RECORD_FULL, file_name
 from bench.results.summary import expectations_and_metrics, net_translation
 from bench.results.telemetry import Telemetry
 from bench.results.writers import CHAIN_COLUMNS, PULSE_COLUMNS, TelemetryWriter
@@ -41,12 +42,18 @@ class Results:
     """One run's measurements (see the module docstring)."""
 
     def __init__(self, sc: Scenario, icd: Icd, run_dir: Path, mode: str, seed: int,
-                 bus_spec: str, n_thrusters: int, open_delay_ns: int) -> None:
+                 bus_spec: str, n_thrusters: int, open_delay_ns: int,
+                 record: str = RECORD_FULL) -> None:
         self.sc, self.icd, self.mode, self.seed, self.bus_spec = sc, icd, mode, seed, bus_spec
+        self.record = record
         deferred = mode == "lockstep"
-        self.telemetry = Telemetry(sc, run_dir / "telemetry.csv", n_thrusters, deferred)
-        self.chains = TelemetryWriter(run_dir / "chains.csv", CHAIN_COLUMNS, deferred)
-        self.pulses = TelemetryWriter(run_dir / "valve_pulses.csv", PULSE_COLUMNS, deferred)
+
+        def path(base: str) -> Path:
+            return run_dir / file_name(base, record)
+
+        self.telemetry = Telemetry(sc, path("telemetry.csv"), n_thrusters, deferred)
+        self.chains = TelemetryWriter(path("chains.csv"), CHAIN_COLUMNS, deferred)
+        self.pulses = TelemetryWriter(path("valve_pulses.csv"), PULSE_COLUMNS, deferred)
         self.fsw = FswView(icd)
         self._open_delay_ns = open_delay_ns
         self.imu_tx_ns: dict[int, int] = {}
@@ -121,6 +128,7 @@ class Results:
             "overrides": list(sc.overrides),
             "mode": self.mode,
             "seed": self.seed,
+            "record": self.record,
             "bus": self.bus_spec,
             "bitrate_bps": sc.bus.bitrate_bps,
             "sim_time_s": sim_time_s,

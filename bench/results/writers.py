@@ -1,7 +1,8 @@
 """Run-folder writers of the results room: CSV tables and summary.json, flushed as they go.
 
 * :class:`TelemetryWriter` — a CSV file with a fixed column list (``telemetry.csv``,
-  ``chains.csv``, ``valve_pulses.csv``, ``frames.csv``): one row of numbers per call,
+  ``chains.csv``, ``valve_pulses.csv``, ``frames.csv``; gzip-compressed when the name ends
+  in ``.gz``, bench.results.record): one row of numbers per call,
   10 significant digits, flushed on demand so a crash loses at most what the caller has
   not flushed. Deferred writing (``deferred=True``, the lockstep bench) keeps rows as
   values and formats them in :meth:`TelemetryWriter.write_pending`, so the text formatting
@@ -17,6 +18,7 @@ import csv
 from pathlib import Path
 from typing import IO, Any
 
+from bench.results.record import open_writer
 from dbc.records import write_record
 
 NUMBER_FORMAT = "%.10g"  # 10 significant digits: 1e-10 on a quaternion, 1 us at 1e4 s
@@ -35,7 +37,7 @@ class TelemetryWriter:
         self.path = path
         self.deferred = deferred
         self._pending: list[list[float | int]] = []
-        self._file: IO[str] = open(path, "w", newline="", encoding="utf-8")  # noqa: SIM115
+        self._file: IO[str] = open_writer(path)
         csv.writer(self._file).writerow(columns)
         self.columns = columns
         self._fmt = ",".join([NUMBER_FORMAT] * len(columns)) + "\n"

@@ -1,5 +1,8 @@
 """The wire's record of the bus: the CAN trace (Vector ASC), per-frame timing, events.
 
+File names are those of a full record; a standard one (the default) adds ``.gz`` to the
+trace and to ``frames.csv`` (bench.results.record).
+
 * ``trace.asc`` — every frame the bench sent or received, in wire order, with its
   modelled (lockstep) or measured (realtime) time of reception; Tx = sent by the bench.
   Written through python-can's ``ASCWriter`` so python-can, Vector tools and SavvyCAN
@@ -31,6 +34,7 @@ from typing import IO, Any
 
 import can
 
+from bench.results.record import RECORD_FULL, file_name, open_writer
 from bench.results.writers import TelemetryWriter
 
 NS_PER_S = 1e9
@@ -47,14 +51,16 @@ PENDING_FRAME, PENDING_ERROR, PENDING_EVENT = 0, 1, 2  # kinds of a deferred tra
 class TraceRecorder:
     """CAN trace in Vector ASC format, plus an events log."""
 
-    def __init__(self, run_dir: Path, start_wall_s: float, deferred: bool = False) -> None:
+    def __init__(self, run_dir: Path, start_wall_s: float, deferred: bool = False,
+                 record: str = RECORD_FULL) -> None:
         """``start_wall_s``: wall-clock time of the run's start (``time.time()`` seconds);
-        ``deferred``: keep frames and events until :meth:`write_pending` (module docstring)."""
-        self.path = run_dir / "trace.asc"
+        ``deferred``: keep frames and events until :meth:`write_pending` (module docstring);
+        ``record``: a level of bench.results.record (plain or compressed files)."""
+        self.path = run_dir / file_name("trace.asc", record)
         self.deferred = deferred
         # (kind, t_ns, message or None, tx, event text): in trace order until written
         self._pending: list[tuple[int, int, can.Message | None, bool, str]] = []
-        self._writer = w = can.ASCWriter(str(self.path), channel=1)
+        self._writer = w = can.ASCWriter(open_writer(self.path), channel=1)
         # The trigger block is dated when the run started (metadata, as the file's "date"
         # line); frame times stay run time, relative to it. Left to python-can, it is dated
         # from the first frame's timestamp: 1 Jan 1970 for a run that starts at t = 0.
@@ -65,7 +71,8 @@ class TraceRecorder:
         w.started = w.last_timestamp = 0.0
         w.log_event("Start of measurement")
         self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
-        self._frames = TelemetryWriter(run_dir / "frames.csv", FRAME_COLUMNS, deferred)
+        self._frames = TelemetryWriter(run_dir / file_name("frames.csv", record),
+                                       FRAME_COLUMNS, deferred)
         self.frames_written = 0
         #: called with (t_ns, event, fields) for every event (bench.operator.alerts)
         self.listener: Callable[[int, str, dict[str, Any]], None] | None = None

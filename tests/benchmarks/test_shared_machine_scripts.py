@@ -46,7 +46,7 @@ def test_run_resources_measures_each_process_and_the_folder() -> None:
         assert run["rss_mb"][role]["growth"] < RSS_GROWTH_BUDGET_MB, role
     assert 0 < run["peak_rss_mb_any_process"] < PEAK_BUDGET_MB
     assert run["folder"]["kb_per_sim_s"] > 0
-    assert "telemetry.csv" in run["folder"]["kb_per_sim_s_by_file"]
+    assert "telemetry.csv.gz" in run["folder"]["kb_per_sim_s_by_file"]  # standard record
 
 
 def test_sigterm_at_random_moments_leaves_valid_summaries_and_nothing_behind() -> None:

@@ -17,6 +17,8 @@ from typing import Any
 
 import pytest
 
+from tests.run_files import run_text
+
 REPO = Path(__file__).resolve().parents[2]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
 # Wall-clock limit of one run: a hang guard, not a measurement. The emulated CI guest
@@ -40,10 +42,11 @@ class Run:
 
 
 def trace_lines(trace: Path) -> list[str]:
-    """An ASC trace's content without its wall-clock header (date line)."""
+    """An ASC trace's content without its wall-clock header (date line); ``trace`` named as
+    in a full record (``.../trace.asc``), read whichever record level wrote it."""
     return [
         ln
-        for ln in trace.read_text().splitlines()
+        for ln in run_text(trace.parent, trace.name).splitlines()
         if not ln.startswith(("date", "Begin Triggerblock"))
     ]
 

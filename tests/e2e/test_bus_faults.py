@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import math
 from pathlib import Path
 
@@ -13,6 +14,7 @@ from bench.wire.timing.arbiter import failed_attempt_bits
 from bench.wire.timing.classic import wire_time_ns
 from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
+from tests.run_files import run_path, run_text
 
 pytestmark = pytest.mark.slow
 
@@ -29,12 +31,12 @@ STUFFING_TOL_US = 25.0  # a few stuff bits per frame, over the ~8 frames on the 
 
 
 def _cmd_rx_s(out: Path) -> dict[int, float]:
-    with open(out / "chains.csv", newline="") as f:
+    with io.StringIO(run_text(out, "chains.csv"), newline="") as f:
         return {int(r["cycle"]): float(r["t_cmd_rx_s"]) for r in csv.DictReader(f)}
 
 
 def _latencies_us(out: Path) -> dict[int, float]:
-    with open(out / "chains.csv", newline="") as f:
+    with io.StringIO(run_text(out, "chains.csv"), newline="") as f:
         return {
             int(r["cycle"]): (float(r["t_cmd_rx_s"]) - float(r["t_imu_tx_s"])) * 1e6
             for r in csv.DictReader(f)
@@ -95,13 +97,13 @@ def test_link_errors_and_bus_off_delay_commands_as_modelled(
     # each an error frame in the trace, in time order with the other frames
     assert run.summary["fault_effects"]["failed_attempts"] == len(err_cycles)
     assert ref.summary["fault_effects"]["failed_attempts"] == 0
-    trace = list(can.LogReader(str(run.out / "trace.asc")))
+    trace = list(can.LogReader(str(run_path(run.out, "trace.asc"))))
     errors = [m.timestamp for m in trace if m.is_error_frame]
     assert len(errors) == len(err_cycles)
     assert all(ERR_FROM_S <= t < ERR_TO_S + PERIOD_S for t in errors)
     stamps = [m.timestamp for m in trace]
     assert stamps == sorted(stamps)
-    assert not any(m.is_error_frame for m in can.LogReader(str(ref.out / "trace.asc")))
+    assert not any(m.is_error_frame for m in can.LogReader(str(run_path(ref.out, "trace.asc"))))
 
 
 def _fault(kind: str, target: str, **params: object) -> str:
@@ -144,7 +146,7 @@ def _first_imu_loss_s(out: Path) -> float | None:
     that cycles k-1 and k brought no IMU_RATE frame (its watchdog sees frames at SYNC, and
     allows LOST_AFTER_PERIODS = 3 IMU periods, 30 ms, of silence); None if never."""
     imu_id = load_database().get_message_by_name("IMU_RATE").frame_id
-    with open(out / "frames.csv", newline="") as f:
+    with io.StringIO(run_text(out, "frames.csv"), newline="") as f:
         sent_s = [float(r["t_ready_s"]) for r in csv.DictReader(f)
                   if int(float(r["id"])) == imu_id and r["tx"] == "1"]
     cycles_with_imu = {math.ceil(round(t / PERIOD_S, 6)) for t in sent_s}
@@ -174,7 +176,7 @@ def test_ten_percent_loss_of_every_sensor_message_converges_or_goes_safe(
     r = run_cli(["run", str(sc), "--bus", unique_bus()], tmp_path / "run", runtime_dir)
     assert "error" not in r.summary, r.stderr
     lost_s = _first_imu_loss_s(r.out)
-    with open(r.out / "telemetry.csv", newline="") as f:
+    with io.StringIO(run_text(r.out, "telemetry.csv"), newline="") as f:
         safe_s = next((float(x["t_s"]) for x in csv.DictReader(f) if x["fsw_mode"] == "2"), None)
     if lost_s is None:
         assert safe_s is None

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import json
 import sys
 from pathlib import Path
@@ -11,6 +12,7 @@ import pytest
 
 from bench.operator.cli import EXIT_RUN_ERROR
 from tests.e2e.conftest import QUICKSTART, REPO, run_cli, trace_lines, unique_bus
+from tests.run_files import run_path, run_text
 
 pytestmark = pytest.mark.slow
 
@@ -39,7 +41,7 @@ def test_same_seed_gives_identical_trace_other_seed_differs(
     assert len(traces[0]) > 1000
     assert traces[0] == traces[1]
     assert traces[0] != traces[2]
-    tel = [(r.out / "telemetry.csv").read_bytes() for r in runs]
+    tel = [run_text(r.out, "telemetry.csv").encode() for r in runs]
     assert tel[0] == tel[1]
 
 
@@ -70,9 +72,9 @@ def test_killed_flight_software_closes_valves_and_keeps_run_folder(
     assert s["deadline_misses"]["stalls"] > 0
     assert s["fsw"]["exit_code"] == -9 and s["fsw"]["log_tail"] is not None
     for name in ("trace.asc", "telemetry.csv", "attitude_error.png"):
-        assert (r.out / name).stat().st_size > 0
+        assert run_path(r.out, name).stat().st_size > 0
     # after the trip no thruster produces thrust (last telemetry rows)
-    with open(r.out / "telemetry.csv", newline="") as f:
+    with io.StringIO(run_text(r.out, "telemetry.csv"), newline="") as f:
         last = list(csv.DictReader(f))[-1]
     assert all(float(v) == 0.0 for k, v in last.items() if k.startswith("thrust_T"))
 

@@ -165,8 +165,8 @@ PLANS: dict[str, Plan] = {
     "pytest my_tests --hil-mode realtime": Plan(
         "skip", why="wall-clock assertions, for exploration only (the project's rule: "
         "realtime measurements stay out of pass/fail tests)"),
-    "python -m can.logconvert runs/a/trace.asc /tmp/a.log": Plan(
-        "run", "python -m can.logconvert runs/a/trace.asc a.log",
+    "python -m can.logconvert runs/a/trace.asc.gz /tmp/a.log": Plan(
+        "run", "python -m can.logconvert runs/a/trace.asc.gz a.log",
         why="a.log in the scratch folder instead of the shared /tmp"),
     "cantools decode --single-line dbc/thruster_hil.dbc < /tmp/a.log": Plan(
         "run", "cantools decode --single-line dbc/thruster_hil.dbc < a.log",

@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from tests.e2e.conftest import QUICKSTART, REPO, run_cli, unique_bus
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -33,7 +34,7 @@ def _with_faults(tmp_path: Path, kind: str, duration_s: float = 0.0) -> Path:
 
 
 def _thrust(out: Path, thruster: int) -> list[tuple[float, float]]:
-    rows = (out / "telemetry.csv").read_text().splitlines()
+    rows = run_text(out, "telemetry.csv").splitlines()
     col = rows[0].split(",").index(f"thrust_T{thruster:02d}_N")
     return [(float(r.split(",")[0]), float(r.split(",")[col])) for r in rows[1:]]
 

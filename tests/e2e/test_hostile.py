@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 
 from tests.e2e.conftest import QUICKSTART, REPO, RUN_TIMEOUT_S, running, unique_bus
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -42,7 +43,7 @@ def _run(tmp_path: Path, runtime_dir: Path, name: str, attack: bool | None) -> d
         if attack is not None:
             sent = _attack(bus, runtime_dir, attack)
     s = json.loads((out / "summary.json").read_text())
-    s["_sent"], s["_telemetry"] = sent, (out / "telemetry.csv").read_bytes()
+    s["_sent"], s["_telemetry"] = sent, run_text(out, "telemetry.csv").encode()
     return s
 
 

@@ -13,6 +13,7 @@ import pytest
 
 from bench.operator.cli import EXIT_BAD_INPUT
 from tests.e2e.conftest import QUICKSTART, REPO, RUN_TIMEOUT_S, running, unique_bus
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -43,9 +44,9 @@ def test_parallel_runs_without_bus_equal_a_run_alone(tmp_path: Path, runtime_dir
         line = next(ln for ln in err.splitlines() if ln.startswith("thruster-hil: bus hilbus:"))
         channels.add(line.split()[2])
     assert len(channels) == PARALLEL_RUNS  # a channel each
-    ref = (tmp_path / "alone" / "telemetry.csv").read_bytes()
+    ref = run_text(tmp_path / "alone", "telemetry.csv").encode()
     for i in range(PARALLEL_RUNS):
-        assert (tmp_path / f"p{i}" / "telemetry.csv").read_bytes() == ref, i
+        assert run_text(tmp_path / f"p{i}", "telemetry.csv").encode() == ref, i
 
 
 def test_second_bench_on_a_named_bus_is_refused_and_reported_by_both(

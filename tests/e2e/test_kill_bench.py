@@ -11,7 +11,9 @@ from pathlib import Path
 import can
 import pytest
 
+from bench.results.record import is_whole
 from tests.e2e.conftest import QUICKSTART, running, unique_bus
+from tests.run_files import run_path, run_text
 
 pytestmark = pytest.mark.slow
 
@@ -46,9 +48,13 @@ def test_sigkill_of_bench_leaves_readable_files_and_no_orphan(
     assert s["partial"] and "signal 9" in s["error"]
     assert s["sim_time_s"] > 0 and s["frames"]["SYNC"]["sent"] > 0
     assert (out / "attitude_error.png").exists()
-    frames = list(can.LogReader(str(out / "trace.asc")))
+    # the compressed files the bench left unfinished were sealed: whole gzip files now
+    assert "trace.asc.gz" in s["files_sealed"] and "telemetry.csv.gz" in s["files_sealed"]
+    assert all(is_whole(out / name) for name in s["files_sealed"])
+    assert any("sealed" in line for line in s["abnormal"])
+    frames = list(can.LogReader(str(run_path(out, "trace.asc"))))
     assert len(frames) > 1000
-    rows = (out / "telemetry.csv").read_text().splitlines()
+    rows = run_text(out, "telemetry.csv").splitlines()
     assert len(rows) > 100 and all(len(r.split(",")) == len(rows[0].split(",")) for r in rows[1:-1])
     # the flight-software child got SIGTERM from the kernel and wrote its statistics
     for pid in _processes_mentioning(str(out / "fsw_config.json")):

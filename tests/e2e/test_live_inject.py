@@ -12,6 +12,7 @@ from dbc.codec import FrameChecker
 from dbc.database import load_database
 from dbc.errors import RefusedConfigError
 from tests.e2e.conftest import QUICKSTART, running, unique_bus
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -39,7 +40,7 @@ def test_inject_reaches_running_bench(
     refused = [f for f in live if f.get("applied") is False]
     assert len(refused) == 1 and f"Target = {MISSING_THRUSTER}" in refused[0]["why"]
     assert 0 <= counter < 15
-    assert "thruster-hil fault_injected" in (out / "trace.asc").read_text()
+    assert "thruster-hil fault_injected" in run_text(out, "trace.asc")
 
 
 def test_cansend_string_is_a_valid_protected_frame() -> None:

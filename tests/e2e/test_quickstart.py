@@ -10,17 +10,20 @@ import pytest
 
 from dbc import e2e
 from dbc.database import load_database
-from tests.e2e.conftest import QUICKSTART, Run, run_cli, unique_bus
+from tests.e2e.conftest import QUICKSTART, Run, run_cli, trace_lines, unique_bus
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
 SETTLING_MAX_S = 10.0
 STEADY_STATE_MAX_DEG = 0.1
-RUN_FILES = (
+RUN_FILES = (  # at the default record level, standard: the trace and tables compressed
     "summary.json",
-    "trace.asc",
-    "telemetry.csv",
-    "valve_pulses.csv",
+    "trace.asc.gz",
+    "telemetry.csv.gz",
+    "valve_pulses.csv.gz",
+    "frames.csv.gz",
+    "chains.csv.gz",
     "events.jsonl",
     "attitude_error.png",
     "rates.png",
@@ -31,6 +34,7 @@ SUMMARY_KEYS = (
     "scenario",
     "mode",
     "seed",
+    "record",
     "bus",
     "sim_time_s",
     "wall_time_s",
@@ -73,6 +77,7 @@ def test_run_folder_is_complete(quickstart: Run) -> None:
     """Every output file exists and summary.json has every key the ICD issue fixes."""
     for name in RUN_FILES:
         assert (quickstart.out / name).stat().st_size > 0, name
+    assert not (quickstart.out / "telemetry.csv").exists()  # not also written plain
     s = quickstart.summary
     assert set(SUMMARY_KEYS) <= set(s)
     lat = s["latency_us"]["sensor_to_command"]
@@ -98,7 +103,7 @@ def test_trace_decodes_and_counters_advance_without_gaps(quickstart: Run) -> Non
     last: dict[int, int] = {}
     per_id: dict[int, int] = defaultdict(int)
     t_prev = -1.0
-    for msg in _trace(quickstart.out / "trace.asc"):
+    for msg in _trace(quickstart.out / "trace.asc.gz"):  # python-can reads .asc.gz itself
         m = db.get_message_by_frame_id(msg.arbitration_id)
         m.decode(msg.data)
         c = e2e.counter_of(msg.data)
@@ -111,3 +116,18 @@ def test_trace_decodes_and_counters_advance_without_gaps(quickstart: Run) -> Non
     assert sum(per_id.values()) == sum(
         f["sent"] for f in quickstart.summary["frames"].values() if f["sent"]
     )
+
+
+def test_full_record_is_the_standard_one_uncompressed(
+    quickstart: Run, tmp_path: Path, runtime_dir: Path
+) -> None:
+    """--record full writes the same trace and tables as plain text, and no .gz files."""
+    full = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--record", "full",
+                    "--duration", str(quickstart.summary["sim_time_s"])], tmp_path / "full",
+                   runtime_dir)
+    assert full.returncode == 0, full.stderr
+    assert full.summary["record"] == "full" and quickstart.summary["record"] == "standard"
+    assert not list(full.out.glob("*.gz"))
+    for name in ("telemetry.csv", "frames.csv", "chains.csv", "valve_pulses.csv"):
+        assert (full.out / name).read_text() == run_text(quickstart.out, name), name
+    assert trace_lines(full.out / "trace.asc") == trace_lines(quickstart.out / "trace.asc")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 from typing import Any
@@ -11,6 +12,7 @@ import numpy as np
 import pytest
 
 from tests.e2e.conftest import REPO, run_cli, unique_bus
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -38,7 +40,7 @@ def _failed(summary: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def _max_thrust_N(run_dir: Path) -> float:
-    with (run_dir / "telemetry.csv").open(newline="", encoding="utf-8") as f:
+    with io.StringIO(run_text(run_dir, "telemetry.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
     cols = [k for k in rows[0] if k.startswith("thrust_T")]
     return max(float(r[k]) for r in rows for k in cols)

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from bench.results.record import read_lines
 from bench.results.writers import CHAIN_COLUMNS
 from dbc.errors import ConfigError, RunError
 
@@ -116,8 +117,7 @@ class ChainTable:
     @classmethod
     def read(cls, path: Path) -> ChainTable:
         """``chains.csv`` of a run folder (also one written before ``t_fire_cmd_rx_s``)."""
-        with open(path, newline="", encoding="utf-8") as f:
-            head = next(csv.reader(f), [])
+        head = next(csv.reader(read_lines(path)), [])
         cols = [c for c in CHAIN_COLUMNS if c != FIRE_COLUMN or c in head]
         return cls.from_columns(read_csv_columns(path, cols))
 
@@ -132,24 +132,21 @@ def read_csv_columns(path: Path, columns: Sequence[str]) -> dict[str, np.ndarray
     whose writer died mid-line) is dropped. Raises :class:`RunError` if the file or a
     column is missing.
     """
-    try:
-        f = open(path, newline="", encoding="utf-8")  # noqa: SIM115 - closed below
-    except FileNotFoundError:
-        raise RunError(f"{path}: missing (not a run folder?)") from None
-    with f:
-        reader = csv.reader(f)
-        head = next(reader, None) or []
-        missing = [c for c in columns if c not in head]
-        if missing:
-            raise RunError(f"{path}: no column(s) {', '.join(missing)} (header {head})")
-        idx = [head.index(c) for c in columns]
-        rows: list[list[float]] = []
-        for r in reader:
-            if len(r) != len(head):
-                continue
-            try:
-                rows.append([float(r[i]) for i in idx])
-            except ValueError:
-                continue
+    if not path.exists():
+        raise RunError(f"{path}: missing (not a run folder?)")
+    reader = csv.reader(read_lines(path))
+    head = next(reader, None) or []
+    missing = [c for c in columns if c not in head]
+    if missing:
+        raise RunError(f"{path}: no column(s) {', '.join(missing)} (header {head})")
+    idx = [head.index(c) for c in columns]
+    rows: list[list[float]] = []
+    for r in reader:
+        if len(r) != len(head):
+            continue
+        try:
+            rows.append([float(r[i]) for i in idx])
+        except ValueError:
+            continue
     arr = np.array(rows, dtype=float).reshape(-1, len(columns))
     return {c: arr[:, j] for j, c in enumerate(columns)}

@@ -96,6 +96,7 @@ from bench.operator.analysis.records import (
     _is_real,
 )
 from bench.operator.analysis.tables import ChainTable, FrameTable, read_csv_columns
+from bench.results.record import run_file
 from bench.results.writers import CHAIN_COLUMNS
 from bench.wire.trace import FRAME_COLUMNS
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps
@@ -170,13 +171,15 @@ class RunTiming:
             raise RunError(f"{summary_path}: not JSON ({exc})") from exc
         db = load_database() if db is None else db
         bitrate = summary.get("bitrate_bps") or _dbc_bitrate_bps(db)
-        frames = FrameTable.from_columns(read_csv_columns(d / "frames.csv", FRAME_COLUMNS))
+        frames = FrameTable.from_columns(read_csv_columns(run_file(d, "frames.csv"),
+                                                          FRAME_COLUMNS))
         origin = summary.get("wall_clock_origin_s")
         if summary.get("mode") == "realtime" and origin is not None and (d / RX_LOG_FILE).exists():
             log = receive_log(read_csv_columns(d / RX_LOG_FILE, RX_LOG_COLUMNS), float(origin))
             frames = dataclasses.replace(frames, t_rx_s=fill_reception(
                 frames.t_ready_s, frames.t_rx_s, frames.can_id, frames.tx, frames.counter, log))
-        chains = ChainTable.read(d / "chains.csv") if (d / "chains.csv").exists() else None
+        chains_path = run_file(d, "chains.csv")
+        chains = ChainTable.read(chains_path) if chains_path.exists() else None
         return cls(
             frames,
             chains,
