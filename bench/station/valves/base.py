@@ -25,7 +25,8 @@ class ValveModel(Protocol):
         ...
 
     def stage_thrusts_N(self, t_ns: int, dt_ns: int) -> tuple[float, float, float]:
-        """Thrust samples for the RK4 stages t, t + dt/2, t + dt [N]."""
+        """Thrust samples for the RK4 stages of [t, t + dt] [N]: both models give the step's
+        mean thrust three times, so the integrated impulse is exact."""
         ...
 
     def command(self, t_ns: int, on_time_ns: int) -> None:

@@ -16,14 +16,16 @@ Inputs / outputs and units
     - Times are integer nanoseconds of simulation time (``t_ns``), never read from a clock.
 
 Bookkeeping (why it matches the plant exactly)
-    ``stage_wrenches(t_ns, dt_ns)`` evaluates the wrench at t, t + dt/2 and t + dt — the
-    three samples ``rk4_step`` takes — and adds each thruster's impulse with Simpson
-    weights, Iᵢ += dt·(Fᵢ(t) + 4 Fᵢ(t + dt/2) + Fᵢ(t + dt))/6. RK4's velocity increment
-    is the same weighted sum of the same samples (for constant attitude it is identical),
-    so the booked impulse is what the body received, including pulses that start or end
-    inside a step. Propellant: mᵢ = Iᵢ / (Isp,ᵢ · g0) (rocket thrust equation,
-    F = ṁ Isp g0; Sutton & Biblarz, "Rocket Propulsion Elements", 9th ed., eq. 2-5),
-    g0 = 9.80665 m/s² (standard gravity, CGPM 1901).
+    ``stage_wrenches(t_ns, dt_ns)`` builds the three wrenches ``rk4_step`` takes from the
+    valves' stage samples (each valve's mean thrust over the step, three times: the
+    closed-form impulse of the step, :mod:`bench.station.valves.thrust_profile`) and adds
+    each thruster's impulse with Simpson weights, Iᵢ += dt·(Fᵢ,0 + 4 Fᵢ,½ + Fᵢ,1)/6. RK4's
+    velocity increment is the same weighted sum of the same samples (for constant attitude
+    it is identical), so the booked impulse is what the body received and what the valve
+    delivered, including pulses that start or end inside a step. Propellant:
+    mᵢ = Iᵢ / (Isp,ᵢ · g0) (rocket thrust equation, F = ṁ Isp g0; Sutton & Biblarz,
+    "Rocket Propulsion Elements", 9th ed., eq. 2-5), g0 = 9.80665 m/s² (standard gravity,
+    CGPM 1901).
     Callers that sample the thrusters themselves (e.g. to add disturbances) can use
     ``thrusts_N`` and ``accumulate`` instead.
 
@@ -306,7 +308,7 @@ class ThrusterSet:
         return (fx, fy, fz, tx, ty, tz)
 
     def stage_wrenches(self, t_ns: int, dt_ns: int) -> tuple[Wrench, Wrench, Wrench]:
-        """Wrenches at t, t + dt/2, t + dt for ``rk4_step``, booking the step's impulse.
+        """The three stage wrenches of [t, t + dt] for ``rk4_step``, booking the step's impulse.
 
         Call once per integration step, with the step actually taken; ``dt_ns`` must be
         positive and even (so that the midpoint is an exact nanosecond).
@@ -349,10 +351,8 @@ class ThrusterSet:
     def account(self, t_ns: int, dt_ns: int) -> None:
         """Book the impulse of the step [t, t + dt] from thrusts re-sampled at its RK4 stages.
 
-        Equivalent to the booking of ``stage_wrenches`` for a caller that built the
-        wrenches with ``wrench_B`` at t, t + dt/2, t + dt (with no command in between;
-        equal up to round-off); it samples every active valve a second time, so
-        ``stage_wrenches`` is cheaper.
+        The booking of ``stage_wrenches`` for a caller that builds its own wrenches; it
+        samples every active valve a second time, so ``stage_wrenches`` is cheaper.
         """
         if dt_ns <= 0 or dt_ns % 2:
             raise ValueError(f"dt_ns must be positive and even, got {dt_ns!r}")

@@ -190,10 +190,9 @@ class Valve:
         return self._profile.thrust_N(t_ns)
 
     def stage_thrusts_N(self, t_ns: int, dt_ns: int) -> tuple[float, float, float]:
-        """Thrust at t, t + dt/2 and t + dt (the RK4 stage times) [N], ``dt_ns`` even.
-
-        Equal to three ``thrust_N`` calls up to round-off, at the cost of one ``exp`` when
-        no segment boundary or cut-off falls inside the step (``ThrustProfile``).
+        """The RK4 stage samples of the step [t, t + dt] [N]: its mean thrust three times,
+        so the integrated impulse is exact wherever drive edges fall (``ThrustProfile``,
+        "Impulse of a step"); one ``exp`` when no segment edge falls inside the step.
         """
         return self._profile.stage_thrusts_N(t_ns, dt_ns)
 

@@ -32,6 +32,7 @@ from bench.station.valves.params import (
 from bench.station.valves.thruster_set import G0_M_S2, ThrusterGeometry, ThrusterSet
 from bench.station.valves.valve import Valve
 from dbc.errors import ConfigError
+from tests.bench.station.thrust_reference import MEAN_REL_TOL, step_mean_reference_N
 
 SEED = 20240611
 MS = 1_000_000  # ns per millisecond
@@ -325,7 +326,7 @@ def test_misalignment_about_any_axis_changes_force_and_torque_rows() -> None:
 # --- combinations and bookkeeping -----------------------------------------------------------
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_random_faults_keep_stage_thrusts_and_bookkeeping_exact(seed: int) -> None:
-    """Random pulses and fault events: stage thrusts = thrust_N at stage times; impulse = m·Δv."""
+    """Random pulses and fault events: stage thrusts = the step's mean thrust; impulse = m·Δv."""
     rng = np.random.default_rng(seed)
     ts = ThrusterSet([_through_com()], _params(rise_tau_s=0.002, tail_tau_s=0.004), rng=rng)
     v = ts.valves[0]
@@ -353,8 +354,9 @@ def test_random_faults_keep_stage_thrusts_and_bookkeeping_exact(seed: int) -> No
                 ts.set_fault(0, kind, at2, **kinds[kind]())
             next_cmd = at + int(rng.integers(0, 40 * MS))
         got = v.stage_thrusts_N(t, DT_NS)
-        want = (v.thrust_N(t), v.thrust_N(t + DT_NS // 2), v.thrust_N(t + DT_NS))
-        assert got == pytest.approx(want, rel=ROUNDOFF_REL, abs=THRUST_CUTOFF_FRACTION * FMAX_N)
+        want = step_mean_reference_N(v, t, DT_NS)
+        assert got[0] == got[1] == got[2]
+        assert got[0] == pytest.approx(want, rel=MEAN_REL_TOL, abs=THRUST_CUTOFF_FRACTION * FMAX_N)
         assert min(got) >= 0.0
         w0, wm, w1 = ts.stage_wrenches(t, DT_NS)
         s = rk4_step(s, DT_NS / NS_PER_S, w0, wm, w1, mp)
@@ -363,7 +365,8 @@ def test_random_faults_keep_stage_thrusts_and_bookkeeping_exact(seed: int) -> No
 
 
 def test_events_inside_one_step_keep_the_step_start_valid() -> None:
-    """Several events inside a step: thrust at the step start is still the pre-event thrust."""
+    """Several events inside a step: the thrust at the step start is still the pre-event
+    thrust, and the step's stage samples are its mean thrust over the events."""
     v = Valve(_params())
     v.command(0, 50 * MS)
     t = 20 * MS
@@ -372,7 +375,8 @@ def test_events_inside_one_step_keep_the_step_start_valid() -> None:
     v.set_fault("degraded", t + 400_000, factor=0.5)
     v.command(t + 500_000, 10 * MS)
     assert v.thrust_N(t) == before
-    assert v.stage_thrusts_N(t, DT_NS)[0] == before
+    got = v.stage_thrusts_N(t, DT_NS)
+    assert got[0] == pytest.approx(step_mean_reference_N(v, t, DT_NS), rel=MEAN_REL_TOL)
     assert DT_NS <= HISTORY_NS
 
 
