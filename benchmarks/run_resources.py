@@ -39,11 +39,12 @@ import zlib
 from pathlib import Path
 from typing import Any
 
+from bench.results.record import GZIP_WBITS
+
 REPO = Path(__file__).resolve().parents[1]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
 KB_PER_MB = 1024.0
 BYTES_PER_KB = 1024.0
-GZIP_WBITS = 16 + 15  # zlib: a gzip stream, 32 KiB window
 ROLES = ("supervisor", "bench", "flight_sw")
 IN_RUN_FRACTION = 0.99  # samples past this share of the duration may be the end-of-run work
 

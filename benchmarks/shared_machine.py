@@ -52,11 +52,11 @@ DURATIONS_S = {"lockstep": 60.0, "realtime": 8.0}
 SIGNAL_WINDOW_S = {"lockstep": 2.5, "realtime": 6.0}
 
 
-
 def _telemetry(run_dir: Path) -> str | None:
     """The text of a run's telemetry, plain or compressed (None if it has none)."""
     path = run_file(run_dir, "telemetry.csv")
     return "".join(read_lines(path)) if path.exists() else None
+
 
 def _start(out: Path, xdg: Path, extra: list[str], group: bool = False) -> subprocess.Popen[str]:
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))

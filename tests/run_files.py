@@ -11,7 +11,3 @@ def run_text(run_dir: Path, base: str) -> str:
     """The text of ``base`` (e.g. ``telemetry.csv``) in ``run_dir``, plain or ``.gz``."""
     return "".join(read_lines(run_file(run_dir, base)))
 
-
-def run_path(run_dir: Path, base: str) -> Path:
-    """The path of ``base`` in ``run_dir`` as written (``base`` or ``base.gz``)."""
-    return run_file(run_dir, base)

@@ -34,7 +34,6 @@ def plot_folder(out: Path, sc: Scenario) -> None:
     plot_run(out, sc.expectations.settling_band_deg)
 
 
-
 def partial_summary(
     sc: Scenario, opts: Any, why: str, refused: str | None = None
 ) -> dict[str, Any]:

@@ -75,9 +75,13 @@ def open_writer(path: Path) -> TextIO:
     if path.suffix != GZ_SUFFIX:
         return open(path, "w", newline="", encoding="utf-8")
     raw = open(path, "wb")  # noqa: SIM115 - owned by the GzipFile's wrapper
-    packed = gzip.GzipFile(filename="", mode="wb", compresslevel=GZIP_LEVEL,
-                           fileobj=raw, mtime=0)
-    return _OwningText(packed, raw)
+    return _OwningText(_gzip_writer(raw), raw)
+
+
+def _gzip_writer(raw: IO[bytes]) -> gzip.GzipFile:
+    """A gzip stream onto ``raw``: level :data:`GZIP_LEVEL`, no name or time in its header
+    (the same bytes give the same file)."""
+    return gzip.GzipFile(filename="", mode="wb", compresslevel=GZIP_LEVEL, fileobj=raw, mtime=0)
 
 
 class _OwningText(io.TextIOWrapper):
@@ -155,8 +159,7 @@ def seal(path: Path) -> bool:
     if path.suffix != GZ_SUFFIX or not path.exists() or is_whole(path):
         return False
     tmp = path.with_name(".sealing-" + path.name)
-    with open(tmp, "wb") as raw, gzip.GzipFile(filename="", mode="wb", fileobj=raw,
-                                               compresslevel=GZIP_LEVEL, mtime=0) as packed:
+    with open(tmp, "wb") as raw, _gzip_writer(raw) as packed:
         for chunk in _flushed_bytes(path):
             packed.write(chunk)
     os.replace(tmp, path)

@@ -8,10 +8,10 @@ from pathlib import Path
 import can
 
 from bench.node import BenchNode
+from bench.results.record import run_file
 from bench.scenario.load import load_scenario
 from dbc.codec import Encoder
 from dbc.database import load_database
-from tests.run_files import run_path
 from transport.spec import open_bus
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
@@ -44,7 +44,7 @@ def test_wait_for_fsw_traces_every_frame_heard(tmp_path: Path) -> None:
     finally:
         peer.shutdown()
         bench_bus.shutdown()
-    with can.LogReader(str(run_path(tmp_path, "trace.asc"))) as reader:
+    with can.LogReader(str(run_file(tmp_path, "trace.asc"))) as reader:
         traced = [m for m in reader if not m.is_error_frame]
     assert [m.arbitration_id for m in traced] == [m.arbitration_id for m in sent]
     assert [bytes(m.data) for m in traced] == [bytes(m.data) for m in sent]

@@ -10,11 +10,12 @@ from pathlib import Path
 import can
 import pytest
 
+from bench.results.record import run_file
 from bench.wire.timing.arbiter import failed_attempt_bits
 from bench.wire.timing.classic import wire_time_ns
 from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
-from tests.run_files import run_path, run_text
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -97,13 +98,13 @@ def test_link_errors_and_bus_off_delay_commands_as_modelled(
     # each an error frame in the trace, in time order with the other frames
     assert run.summary["fault_effects"]["failed_attempts"] == len(err_cycles)
     assert ref.summary["fault_effects"]["failed_attempts"] == 0
-    trace = list(can.LogReader(str(run_path(run.out, "trace.asc"))))
+    trace = list(can.LogReader(str(run_file(run.out, "trace.asc"))))
     errors = [m.timestamp for m in trace if m.is_error_frame]
     assert len(errors) == len(err_cycles)
     assert all(ERR_FROM_S <= t < ERR_TO_S + PERIOD_S for t in errors)
     stamps = [m.timestamp for m in trace]
     assert stamps == sorted(stamps)
-    assert not any(m.is_error_frame for m in can.LogReader(str(run_path(ref.out, "trace.asc"))))
+    assert not any(m.is_error_frame for m in can.LogReader(str(run_file(ref.out, "trace.asc"))))
 
 
 def _fault(kind: str, target: str, **params: object) -> str:

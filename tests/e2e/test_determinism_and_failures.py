@@ -11,8 +11,9 @@ from pathlib import Path
 import pytest
 
 from bench.operator.cli import EXIT_RUN_ERROR
+from bench.results.record import run_file
 from tests.e2e.conftest import QUICKSTART, REPO, run_cli, trace_lines, unique_bus
-from tests.run_files import run_path, run_text
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -72,7 +73,7 @@ def test_killed_flight_software_closes_valves_and_keeps_run_folder(
     assert s["deadline_misses"]["stalls"] > 0
     assert s["fsw"]["exit_code"] == -9 and s["fsw"]["log_tail"] is not None
     for name in ("trace.asc", "telemetry.csv", "attitude_error.png"):
-        assert run_path(r.out, name).stat().st_size > 0
+        assert run_file(r.out, name).stat().st_size > 0
     # after the trip no thruster produces thrust (last telemetry rows)
     with io.StringIO(run_text(r.out, "telemetry.csv"), newline="") as f:
         last = list(csv.DictReader(f))[-1]

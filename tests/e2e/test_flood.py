@@ -8,9 +8,9 @@ from pathlib import Path
 import can
 import pytest
 
+from bench.results.record import run_file
 from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, flood, running, unique_bus
-from tests.run_files import run_path
 
 pytestmark = pytest.mark.slow
 
@@ -38,7 +38,7 @@ def test_flood_is_counted_by_cause_and_nothing_crashes(tmp_path: Path, runtime_d
         for cause in ("crc", "dlc", "remote_frame"):
             assert frames[own]["rejected"].get(cause, 0) == sent[side][cause], (side, cause)
     known = {m.frame_id for m in load_database().messages}
-    heard = list(can.LogReader(str(run_path(out, "trace.asc"))))
+    heard = list(can.LogReader(str(run_file(out, "trace.asc"))))
     assert sum(m.is_error_frame for m in heard) == sent["ALL"]["error_frame"]
     unknown = sum(not m.is_error_frame and m.arbitration_id not in known for m in heard)
     assert unknown == sent["ALL"]["unknown_id"]

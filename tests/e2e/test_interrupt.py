@@ -10,8 +10,8 @@ from pathlib import Path
 import can
 import pytest
 
+from bench.results.record import run_file
 from tests.e2e.conftest import QUICKSTART, running, unique_bus
-from tests.run_files import run_path
 
 pytestmark = pytest.mark.slow
 
@@ -38,9 +38,9 @@ def test_ctrl_c_exits_130_with_a_complete_folder(
     assert any(e["event"] == "run_interrupted" for e in events)
     assert "Traceback" not in (out / "fsw.log").read_text(encoding="utf-8")
     assert json.loads((out / "fsw_stats.json").read_text(encoding="utf-8"))["cycles"] > 0
-    with can.LogReader(str(run_path(out, "trace.asc"))) as reader:
+    with can.LogReader(str(run_file(out, "trace.asc"))) as reader:
         assert sum(1 for _ in reader) > 0
-    assert all(run_path(out, f).exists() for f in ("telemetry.csv", "attitude_error.png"))
+    assert all(run_file(out, f).exists() for f in ("telemetry.csv", "attitude_error.png"))
 
 
 @pytest.mark.parametrize("mode", ["lockstep", "realtime"])

@@ -11,9 +11,9 @@ from pathlib import Path
 import can
 import pytest
 
-from bench.results.record import is_whole
+from bench.results.record import is_whole, run_file
 from tests.e2e.conftest import QUICKSTART, running, unique_bus
-from tests.run_files import run_path, run_text
+from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
@@ -52,7 +52,7 @@ def test_sigkill_of_bench_leaves_readable_files_and_no_orphan(
     assert "trace.asc.gz" in s["files_sealed"] and "telemetry.csv.gz" in s["files_sealed"]
     assert all(is_whole(out / name) for name in s["files_sealed"])
     assert any("sealed" in line for line in s["abnormal"])
-    frames = list(can.LogReader(str(run_path(out, "trace.asc"))))
+    frames = list(can.LogReader(str(run_file(out, "trace.asc"))))
     assert len(frames) > 1000
     rows = run_text(out, "telemetry.csv").splitlines()
     assert len(rows) > 100 and all(len(r.split(",")) == len(rows[0].split(",")) for r in rows[1:-1])

@@ -7,9 +7,9 @@ from pathlib import Path
 import can
 import pytest
 
+from bench.results.record import run_file
 from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, run_cli
-from tests.run_files import run_path
 
 pytestmark = pytest.mark.socketcan
 
@@ -33,7 +33,7 @@ def test_lockstep_quickstart_over_vcan(tmp_path: Path, runtime_dir: Path) -> Non
             assert f["received"] == f["sent"] and f["rejected"] == {}, name
     db = load_database()
     n = 0
-    for msg in can.LogReader(str(run_path(r.out, "trace.asc"))):
+    for msg in can.LogReader(str(run_file(r.out, "trace.asc"))):
         db.decode_message(msg.arbitration_id, msg.data)
         n += 1
     assert n == sum(f["sent"] for f in s["frames"].values() if f["sent"])
