@@ -3,9 +3,12 @@
 What it does: from the effectiveness matrix ``B`` (columns ``[d; r × d]``: force [N] and
 torque [N m] per newton of each thruster, flight_sw.allocation.effectiveness), for each
 signed body axis ±x, ±y, ±z of the torque (and of the force, when this flight software
-controls translation too) whether some thrusts ``T ≥ 0`` produce it: the non-negative
-least-squares residual of ``B T = ±e_i`` (Lawson & Hanson 1974, ch. 23; scipy's ``nnls``)
-is zero to round-off exactly when the axis lies in the cone of the columns. An axis outside
+controls translation too) whether some thrusts ``T ≥ 0`` produce it: the least
+absolute residual of ``B T = ±e_i`` over ``T ≥ 0`` (a linear programme with slacks
+``B T + s⁺ − s⁻ = ±e_i``, minimising ``Σ s``; HiGHS, flight_sw.allocation.linear_program)
+is zero to round-off exactly when the axis lies in the cone of the columns (Lawson &
+Hanson 1974, ch. 23, for the same test by non-negative least squares, which tests/ use as
+the reference). An axis outside
 it is a demand the allocator can never meet: the configuration is accepted (seed 004
 controls a vehicle with three thrusters) but warned about, in the statistics file
 (``warnings``, which the bench shows on its console) and by ``--check``.
@@ -17,11 +20,23 @@ Pure functions; no units beyond the inputs'.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import nnls
 
-# An axis counts as reached when the NNLS residual is below this (unit target vector).
+from flight_sw.allocation.linear_program import solve_lp
+
+# An axis counts as reached when the residual ‖B T − e‖ is below this (unit target).
 REACH_TOL = 1e-9
 AXES = ("x", "y", "z")
+def _cone_residual(rows: np.ndarray, target: np.ndarray) -> float:
+    """``‖rows T − target‖`` at the ``T ≥ 0`` of least absolute residual (an LP)."""
+    m, n = rows.shape
+    eye = np.eye(m)
+    x = solve_lp(np.r_[np.zeros(n), np.ones(2 * m)], np.zeros(n + 2 * m),
+                 np.full(n + 2 * m, np.inf), np.hstack([rows, eye, -eye]), target)
+    if x is None:  # always feasible (the slacks): only a solver failure gets here
+        return float("inf")
+    return float(np.linalg.norm(rows @ np.maximum(x[:n], 0.0) - target))
+
+
 def unreached_axes(rows: np.ndarray) -> list[str]:
     """The signed axes (``+x`` ... ``-z``) of ``rows`` (3 × n) no thrusts ``T ≥ 0`` give."""
     out = []
@@ -29,8 +44,7 @@ def unreached_axes(rows: np.ndarray) -> list[str]:
         for sign in (1.0, -1.0):
             target = np.zeros(3)
             target[i] = sign
-            _, residual = nnls(rows, target)
-            if residual > REACH_TOL:
+            if _cone_residual(rows, target) > REACH_TOL:
                 out.append(f"{'+' if sign > 0 else '-'}{axis}")
     return out
 

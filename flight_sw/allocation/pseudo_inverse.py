@@ -8,21 +8,26 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
    effectiveness matrix restricted to the available thrusters; computed once).
 2. Non-negativity by null-space shifts that cost the least propellant: for each thruster
    ``i`` a non-negative null vector ``n_i`` with ``n_i[i] = 1`` and the smallest total
-   thrust (``B n_i = 0``, so the achieved demand is unchanged) is found once at construction
-   by the linear programme "minimise Σ v subject to B v = 0, v ≥ 0, v_i = 1" (scipy
-   ``linprog``); each negative ``T_i`` is lifted to zero by ``T ← T + (−T_i) n_i`` (the
-   other components only grow, so one pass suffices). For the seed-003 layout ``n_i`` is the
-   opposing thruster of ``i`` (a pure couple), so a pure pitch demand fires exactly one
-   couple. A single strictly positive null vector ``v`` (found by "maximise t subject to
-   B v = 0, Σ v = 1, v_i ≥ t") must exist: the thrusters must positively span the
-   attainable space; it also serves step 3. Steps 1–2 do not depend on the bounds.
+   thrust (``B n_i = 0``, so the achieved demand is unchanged) is found once at
+   construction by the linear programme "minimise Σ v subject to B v = 0, v ≥ 0,
+   v_i = 1" (HiGHS, :mod:`flight_sw.allocation.linear_program`; each thruster's cost is
+   ``1 + 10⁻⁹ j``, so among rays of equal fuel the one on the lowest-numbered thrusters
+   is taken, whatever the solver's pivoting); each negative ``T_i`` is lifted to zero by
+   ``T ← T + (−T_i) n_i`` (the other components only grow, so one pass suffices). For
+   the seed-003 layout ``n_i`` is the opposing thruster of ``i`` (a pure couple), so a
+   pure pitch demand fires exactly one couple. A single strictly positive null vector
+   ``v`` (found by "maximise t subject to B v = 0, Σ v = 1, v_i ≥ t") must exist: the
+   thrusters must positively span the attainable space; it also serves step 3. Steps 1–2
+   do not depend on the bounds.
 3. Upper bounds: if some ``T_i > T_max,i``:
    a. if the demand is *attainable* — inside the attainable set
       ``A = {B T : 0 ≤ T_i ≤ T_max,i} = Σ_j [0, T_max,j] g_j`` (``g_j`` the columns of
       ``B``), a zonotope — and ``exact_repair`` is on, solve the bounded least-squares
-      problem ``min ‖B T − d‖, 0 ≤ T ≤ T_max`` (scipy ``lsq_linear``, BVLS), which then has
-      a zero residual: an attainable demand is always reproduced exactly. The test is one
-      small matrix-vector product against the facet inequalities ``n·x ≤ h(n)``
+      problem ``min ‖B T − d‖, 0 ≤ T ≤ T_max`` as the box QP ``M = BᵀB``, ``c = Bᵀd`` of
+      :func:`flight_sw.allocation.active_set.box_qp` (the exact active-set solver the QP
+      allocators use; least-norm on its free set), which then has a zero residual: an
+      attainable demand is always reproduced exactly. The test is one small
+      matrix-vector product against the facet inequalities ``n·x ≤ h(n)``
       precomputed at construction: a facet normal ``n`` is orthogonal to r − 1
       independent generators (the bounds scale the generators, not their directions,
       so the normals are those of ``B``), with support ``h(n) = Σ_j T_max,j max(n·g_j, 0)``
@@ -36,7 +41,7 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
    attainable demand. For the seed-003 layout the shifted pseudo-inverse needs up to
    1.5 T_max on attainable demands (e.g. thrusters 3, 4, 5, 6 and 8 all at T_max need
    1.25 T_max); about 0.6 % (torque) and 2 % (wrench) of demands ``B·U(0, T_max)⁸``
-   overflow. Step 3a runs only for those (≈ 60–120 µs each); unattainable demands,
+   overflow. Step 3a runs only for those (≈ 20 µs each); unattainable demands,
    the common saturated case during slews, take the cheap step 3b.
    With equal bounds every quantity above is computed exactly as the scalar form did
    (``h = T_max Σ_j max(n·g_j, 0)``, ``s = T_max / max T``), bit for bit: the bounds
@@ -45,7 +50,7 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
 
 Fallback: when no strictly positive null vector exists (fewer or badly placed available
 thrusters, e.g. after masking), steps 1–3 do not apply and every call solves the bounded
-least-squares problem with ``lsq_linear`` (BVLS; ≈ 60–120 µs per call): feasible demands are
+least-squares problem as that box QP (≈ 20 µs per call): feasible demands are
 reproduced, others get the bounded least-squares optimum (not direction-preserving).
 :attr:`PseudoInverseAllocator.uses_null_space_shift` tells which path an instance uses.
 
@@ -71,8 +76,10 @@ direction-preserving scaling: Durham 1993, "Constrained control allocation", JGC
 717–725, and Durham 1994, "Attainable moments for the constrained control allocation
 problem", JGCD 17(6) 1371–1373; null-space shift for unidirectional thrusters: Wie 2008,
 "Space Vehicle Dynamics and Control", 2nd ed., ch. 7; seed 003 (``E⁺ = Eᵀ(EEᵀ)⁻¹`` with
-an on-off relay); BVLS: Stark & Parker 1995, "Bounded-variable least-squares: an
-algorithm and applications", Comput. Stat. 10(2) 129–141.
+an on-off relay); bounded least squares: Björck 1996, "Numerical Methods for Least
+Squares Problems", sec. 5.2, solved as in :mod:`flight_sw.allocation.active_set`.
+No scipy.optimize here: importing it cost the flight software's start-up ~0.3 s (issue 23);
+tests/ check both problems against scipy's ``linprog`` and ``lsq_linear``.
 """
 
 from __future__ import annotations
@@ -82,13 +89,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linprog, lsq_linear
 
 from dbc import validation as check
+from flight_sw.allocation.active_set import FREE, box_qp
 from flight_sw.allocation.base import RANK_RTOL, BoundSpec, ControlAllocation
+from flight_sw.allocation.linear_program import solve_lp
 
 # Smallest component (of a unit-sum null vector) accepted as "strictly positive".
 NULL_VECTOR_MIN_COMPONENT = 1e-9
+# Per thruster number, the extra cost that breaks ties between null rays of equal fuel.
+RAY_ORDER_WEIGHT = 1e-9
 # Thrust above T_max,i × (1 + THRUST_RTOL) counts as an overflow (round-off slack).
 THRUST_RTOL = 1e-12
 
@@ -130,11 +140,11 @@ def _positive_null_vector(b: np.ndarray, pinv: np.ndarray) -> np.ndarray | None:
     b_eq = np.zeros(m + 1)
     b_eq[m] = 1.0
     a_ub = np.hstack([-np.eye(n), np.ones((n, 1))])  # t − v_i ≤ 0
-    bounds = [(0.0, None)] * n + [(None, None)]
-    res = linprog(cost, A_ub=a_ub, b_ub=np.zeros(n), A_eq=a_eq, b_eq=b_eq, bounds=bounds)
-    if res.status != 0 or res.x is None:
+    lo = np.r_[np.zeros(n), -np.inf]
+    x = solve_lp(cost, lo, np.full(n + 1, np.inf), a_eq, b_eq, a_ub, np.zeros(n))
+    if x is None:
         return None
-    v = np.asarray(res.x[:n], dtype=float)
+    v = x[:n]
     v = v - pinv @ (b @ v)  # remove the LP's round-off component outside the null space
     v = v / v.sum()
     if v.min() <= NULL_VECTOR_MIN_COMPONENT:
@@ -146,13 +156,17 @@ def _min_fuel_null_rays(b: np.ndarray) -> np.ndarray | None:
     """Row i: the non-negative null vector with component i = 1 and least sum, or None."""
     m, n = b.shape
     rays = np.zeros((n, n))
+    # Ties (layouts with several least-fuel couples, e.g. opposing valve pairs) go to the
+    # lowest-numbered thrusters, whatever the solver's pivoting would pick: the cost of
+    # thruster j is 1 + RAY_ORDER_WEIGHT × j (a vertex, so the values are the ray's own).
+    cost = 1.0 + RAY_ORDER_WEIGHT * np.arange(n)
     for i in range(n):
-        bounds: list[tuple[float, float | None]] = [(0.0, None)] * n
-        bounds[i] = (1.0, 1.0)
-        res = linprog(np.ones(n), A_eq=b, b_eq=np.zeros(m), bounds=bounds)
-        if res.status != 0 or res.x is None:
+        lo, hi = np.zeros(n), np.full(n, np.inf)
+        lo[i] = hi[i] = 1.0
+        x = solve_lp(cost, lo, hi, b, np.zeros(m))
+        if x is None:
             return None
-        rays[i] = np.maximum(np.asarray(res.x, dtype=float), 0.0)
+        rays[i] = np.maximum(x, 0.0)
         rays[i, i] = 1.0
     return rays
 
@@ -203,6 +217,8 @@ class PseudoInverseAllocator(ControlAllocation):
         # inequalities mapped to demand space, ``normals·U_rᵀ d ≤ h + tol``.
         self._neg_inv_v = None if self._null_v is None else -1.0 / self._null_v
         self._overflow_N = u_a * (1.0 + THRUST_RTOL)
+        self._normal: list[list[float]] | None = None  # BᵀB of the bounded least squares
+        self._free = np.full(u_a.size, FREE, dtype=np.int8)
         self._halfspaces: tuple[np.ndarray, np.ndarray] | None = None
         if self._null_v is not None and params.exact_repair and rank:
             u_ref = float(np.max(u_a))
@@ -234,8 +250,12 @@ class PseudoInverseAllocator(ControlAllocation):
         return bool((normals_d @ d <= h_tol).all())
 
     def _bounded_lsq(self, d: np.ndarray) -> np.ndarray:
-        res = lsq_linear(self._b_a, d, bounds=(0.0, self._hi_a), method="bvls")
-        return np.asarray(res.x, dtype=float)
+        """``argmin ‖B T − d‖²`` over ``0 ≤ T ≤ T_max`` (least-norm where not unique)."""
+        if self._normal is None:
+            self._normal = (self._b_a.T @ self._b_a).tolist()
+        x, _ = box_qp(np.zeros(0), self._b_a.T @ d, np.zeros(self._hi_a.size), self._hi_a,
+                      self._free, False, self._normal)
+        return x
 
     def _in_range_residual(self, d: np.ndarray, t_a: np.ndarray) -> float:
         return float(np.linalg.norm(self._range_T @ (d - self._b_a @ t_a)))

@@ -6,7 +6,9 @@ from Table 1, gains or an LQR design, seed 001's direct-parametric MRP law), cou
 laws (:data:`POSE_CONTROLLERS`: seed 000's NFTSM and TSM, every field optional, nominal
 mass and inertia from the vehicle) and translation laws
 (:data:`TRANSLATION_CONTROLLERS`: position PD, with its optional hold position). Angles
-and rates in the file are in degrees, converted here.
+and rates in the file are in degrees, converted here. The two laws designed with
+scipy.linalg (the cascade's Riccati solution, the MRP law's block matrices) are imported
+when chosen, so a flight software that uses neither starts without scipy.
 """
 
 from __future__ import annotations
@@ -27,8 +29,6 @@ from flight_sw.builders.vehicle import (
     nominal_mass,
 )
 from flight_sw.control.base import AttitudeController, PoseController, TranslationController
-from flight_sw.control.cascade_lqr import CascadeLqr, CascadeLqrDesign, CascadeLqrParams
-from flight_sw.control.mrp_direct_parametric import MrpDirectParametric, MrpDirectParametricParams
 from flight_sw.control.nftsm_dq import NftsmDq, NftsmDqParams
 from flight_sw.control.position_pd import PositionPd, PositionPdParams
 from flight_sw.control.quaternion_pd import QuaternionPd, QuaternionPdParams
@@ -73,6 +73,8 @@ def _quaternion_pid(t: Table, v: Vehicle) -> AttitudeController:
 
 def _cascade_lqr(t: Table, v: Vehicle) -> AttitudeController:
     """Seed 003: Table 1 gains (``table1 = true``), explicit gains, or an LQR design."""
+    from flight_sw.control.cascade_lqr import CascadeLqr, CascadeLqrDesign, CascadeLqrParams
+
     rate_limit = max_rate(t)
     table1 = t.raw("table1", False)
     if not isinstance(table1, bool):
@@ -100,6 +102,11 @@ def _cascade_lqr(t: Table, v: Vehicle) -> AttitudeController:
 
 def _mrp_direct_parametric(t: Table, v: Vehicle) -> AttitudeController:
     """Seed 001 §3: cases 1-3 of §5, or an explicit F0 (6×6) and Z (3×6)."""
+    from flight_sw.control.mrp_direct_parametric import (
+        MrpDirectParametric,
+        MrpDirectParametricParams,
+    )
+
     if t.has("f0"):
         params = MrpDirectParametricParams(
             f0=tuple(tuple(float(x) for x in r) for r in matrix(t, "f0", 6, 6)),

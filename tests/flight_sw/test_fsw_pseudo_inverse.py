@@ -277,3 +277,37 @@ def test_per_thruster_maxima_of_the_wrong_length_are_refused(
     with pytest.raises(ConfigError) as info:
         PseudoInverseParams((max_thrust_n, 0.0))
     assert info.value.key == "max_thrust_N"
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_min_fuel_null_rays_match_linprog(
+    layout: tuple[np.ndarray, np.ndarray], rows: str
+) -> None:
+    """Each thruster's least-fuel null ray has the fuel scipy's linprog finds (the reference)."""
+    from scipy.optimize import linprog
+
+    from flight_sw.allocation.pseudo_inverse import _min_fuel_null_rays
+
+    b = matrix(layout, rows)
+    m, n = b.shape
+    rays = _min_fuel_null_rays(b)
+    assert rays is not None
+    for i in range(n):
+        bounds: list[tuple[float, float | None]] = [(0.0, None)] * n
+        bounds[i] = (1.0, 1.0)
+        ref = linprog(np.ones(n), A_eq=b, b_eq=np.zeros(m), bounds=bounds)
+        assert rays[i, i] == 1.0 and np.all(rays[i] >= 0.0)
+        assert np.abs(b @ rays[i]).max() <= FEASIBLE_RESIDUAL_TOL
+        assert abs(rays[i].sum() - ref.fun) <= FEASIBLE_RESIDUAL_TOL
+
+
+def test_equal_fuel_rays_go_to_the_lowest_numbered_thrusters() -> None:
+    """Columns g, −g, −g: thruster 0 is cancelled by 1 or 2 at equal fuel; 1 is taken,
+    whatever the solver's pivoting, and thruster 2's partner is 0."""
+    from flight_sw.allocation.pseudo_inverse import _min_fuel_null_rays
+
+    b = np.array([[1.0, -1.0, -1.0], [0.5, -0.5, -0.5]])
+    rays = _min_fuel_null_rays(b)
+    assert rays is not None
+    np.testing.assert_array_equal(rays[0], [1.0, 1.0, 0.0])
+    np.testing.assert_array_equal(rays[2], [1.0, 0.0, 1.0])

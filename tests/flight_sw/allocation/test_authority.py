@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from bench.scenario.load import load_scenario
-from flight_sw.allocation.authority import authority_warnings, unreached_axes
+from flight_sw.allocation.authority import REACH_TOL, authority_warnings, unreached_axes
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 
 QUICKSTART = Path(__file__).resolve().parents[3] / "scenarios" / "quickstart.toml"
@@ -41,3 +41,21 @@ def test_a_torque_only_layout_is_warned_only_when_force_is_controlled() -> None:
     assert authority_warnings(b, controls_force=False) == []
     (w,) = authority_warnings(b, controls_force=True)
     assert "cannot produce force" in w
+
+
+def test_cone_test_agrees_with_nonnegative_least_squares() -> None:
+    """Random 3 × n sets: the unreached axes are those with a non-zero NNLS residual
+    (scipy's nnls, Lawson & Hanson, the reference)."""
+    from scipy.optimize import nnls
+
+    rng = np.random.default_rng(11)
+    for _ in range(60):
+        rows = rng.normal(size=(3, int(rng.integers(1, 7))))
+        expected = []
+        for i, axis in enumerate("xyz"):
+            for sign in (1.0, -1.0):
+                target = np.zeros(3)
+                target[i] = sign
+                if nnls(rows, target)[1] > REACH_TOL:
+                    expected.append(f"{'+' if sign > 0 else '-'}{axis}")
+        assert unreached_axes(rows) == expected
