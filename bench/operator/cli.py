@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import gc
 import json
 import sys
 from pathlib import Path
 from typing import Any
 
+from bench.operator.console import print_summary, progress_printer
 from bench.operator.lifecycle import Stopped
-from bench.operator.verdict import abnormal, verdict
 from bench.results.record import RECORD_CHOICES, RECORD_STANDARD
 from dbc import options as opt
 from dbc.datafile import parse_json, read_text
@@ -31,86 +32,7 @@ from transport.spec import BusSpec, check_bus_spec, default_bus_spec, private_bu
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
-BAR_WIDTH = 30
 MAX_SUMMARY_BYTES = 64 << 20  # a summary.json of a long run with many faults: a few MB
-
-
-def _progress_printer() -> Any:
-    tty = sys.stderr.isatty()
-    last = [-1.0]
-
-    def show(t_s: float, total_s: float) -> None:
-        frac = min(1.0, t_s / total_s) if total_s > 0 else 1.0
-        if tty:
-            n = int(frac * BAR_WIDTH)
-            sys.stderr.write(f"\r[{'#' * n}{'.' * (BAR_WIDTH - n)}] {t_s:7.2f}/{total_s:.2f} s sim")
-            sys.stderr.flush()
-        elif frac - last[0] >= 0.1 or frac >= 1.0:
-            last[0] = frac
-            sys.stderr.write(f"progress {frac * 100:5.1f} % ({t_s:.1f}/{total_s:.1f} s sim)\n")
-
-    return show
-
-
-def _fmt(x: Any, spec: str = ".4f", none: str = "n/a") -> str:
-    return none if x is None else format(x, spec)
-
-
-def _settling_text(settling: float | None) -> str:
-    if settling is None:
-        return "not settled"
-    return f"{settling:.2f} s" + (" (never left the band)" if settling == 0.0 else "")
-
-
-def _position_text(s: dict[str, Any]) -> str:
-    """Position errors where the run has a position reference; else the translation the
-    firing caused (an attitude-only run has no position to be in error from)."""
-    if s.get("final_position_error_m") is not None:
-        return (f"position error final {_fmt(s['final_position_error_m'])} m, steady-state "
-                f"{_fmt(s.get('steady_state_position_error_m'))} m")
-    tr = s.get("net_translation")
-    if not tr:
-        return ""
-    return (f"translation caused by the firing (attitude only: no position reference) "
-            f"{tr['displacement_m']:.3f} m, delta-v {tr['delta_v_m_s'] * 1000:.1f} mm/s")
-
-
-def _print_summary(s: dict[str, Any], out: Path) -> None:
-    lat = s["latency_us"]["sensor_to_command"]
-    dm = s.get("deadline_misses") or {}
-    settling = s["settling_time_s"]
-    lines = [
-        f"scenario {s['scenario']} | mode {s['mode']} | bus {s['bus']} | seed {s['seed']}",
-        f"sim {s['sim_time_s']:.1f} s in {_fmt(s['wall_time_s'], '.2f')} s wall "
-        f"(real-time factor {_fmt(s['realtime_factor'], '.1f')})",
-        f"converged {s['converged']} | settling "
-        f"{_settling_text(settling)} | steady-state error "
-        f"{_fmt(s['steady_state_attitude_error_deg'])} deg, "
-        f"{_fmt(s['steady_state_rate_error_deg_s'])} deg/s",
-        _position_text(s),
-        f"propellant {s['propellant_kg'] * 1000:.1f} g | valve openings "
-        f"{(s.get('valve_openings') or {}).get('total', 'n/a')}",
-        f"latency sensor->command p50 {_fmt(lat['p50'], '.0f')} us, p99 {_fmt(lat['p99'], '.0f')}"
-        f" us, max {_fmt(lat['max'], '.0f')} us (n={lat['n']}) | stalls {dm.get('stalls', 0)}, "
-        f"flight-software overruns {dm.get('fsw_overruns', 0)}, "
-        f"bench late {dm.get('bench_late', 0)}",
-    ]
-    lines = [x for x in lines if x]
-    if not s["converged"]:  # a run fails on this alone, with or without expectations
-        lines.append(f"  FAIL converged: the attitude error did not end inside the "
-                     f"{_fmt(s.get('settling_band_deg'), 'g')} deg settling band")
-    for e in s["expectations"]:
-        lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {_fmt(e['value'])} "
-                     f"(max {e['max']}{'; ' + e['note'] if e.get('note') else ''})")
-    for w in s.get("warnings", []):
-        lines.append(f"  WARNING {w}")
-    if "error" in s:
-        lines.append(f"  ERROR {s['error']}")
-    lines.append(f"verdict: {s.get('verdict') or verdict(s)}")
-    found = s["abnormal"] if isinstance(s.get("abnormal"), list) else abnormal(s)
-    lines += [f"  ABNORMAL {x}" for x in found] or ["  nothing abnormal"]
-    lines.append(f"run folder: {out}")
-    print("\n".join(lines))
 
 
 def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
@@ -140,6 +62,7 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         fsw_cmd=None if alone else (args.fsw_cmd or DEFAULT_FSW_CMD),
         bus_shared=args.bus is not None,
         record=args.record,
+        plots=not args.no_plots,
     )
     opts = dataclasses.replace(opts, out=prepare_run_folder(Path(args.out), args.replace)
                                if args.out else default_run_folder(sc.name))
@@ -154,11 +77,19 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
             flush=True,
         )
 
-    summary = run_scenario(sc, opts, _progress_printer(), ready if alone else None,
-                           alerts.printer())
-    if sys.stderr.isatty():
-        sys.stderr.write("\n")
-    _print_summary(summary, opts.out)
+    printed: list[bool] = []
+
+    def show(summary: dict[str, Any]) -> None:  # the verdict first, then the plots are drawn
+        if sys.stderr.isatty():
+            sys.stderr.write("\n")
+        print_summary(summary, opts.out)
+        sys.stdout.flush()
+        printed.append(True)
+
+    summary = run_scenario(sc, opts, progress_printer(), ready if alone else None,
+                           alerts.printer(), show)
+    if not printed:
+        show(summary)
     return EXIT_OK if summary["passed"] else EXIT_FAILED
 
 
@@ -175,7 +106,7 @@ def _cmd_report(args: argparse.Namespace) -> int:
     try:
         for p in plot_run(run_dir, s.get("settling_band_deg")):
             print(f"wrote {p}")
-        _print_summary(s, run_dir)
+        print_summary(s, run_dir)
     except KeyError as exc:
         raise ConfigError(str(path), str(exc.args[0]), None, "a summary.json written by "
                           "thruster-hil (this key is missing)") from exc
@@ -292,6 +223,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="standard: the CAN trace and the CSV tables gzip-compressed "
                        "(trace.asc.gz, telemetry.csv.gz, ...: about a fifth of the size); "
                        "full: the same files as plain text (default standard)")
+        r.add_argument("--no-plots", action="store_true",
+                       help="leave out the PNG plots (~0.7 s: matplotlib's import and the "
+                       "drawing); `thruster-hil report RUN_DIR` draws them later")
         r.add_argument("--replace", action="store_true",
                        help="let --out name a folder holding an earlier run, which is deleted")
         r.add_argument("--duration", type=opt.number("--duration", control_period_s,
@@ -453,6 +387,16 @@ def main(argv: list[str] | None = None) -> int:
     if isinstance(args, int):
         return args
     try:
+        return _dispatch(args)
+    finally:
+        # What was loaded (matplotlib's heap, the bench's tables) is never collected again:
+        # the interpreter's last collection would walk all of it on exit (~0.1 s)
+        gc.freeze()
+
+
+def _dispatch(args: argparse.Namespace) -> int:
+    """Run the chosen subcommand; errors become exit codes (module docstring)."""
+    try:
         if args.command == "report":
             return _cmd_report(args)
         if args.command == "timing":
@@ -470,7 +414,7 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_RUN_ERROR
     except Stopped as exc:
         if exc.summary is not None and exc.out is not None:
-            _print_summary(exc.summary, exc.out)
+            print_summary(exc.summary, exc.out)
         print(f"\nthruster-hil: stopped by {exc.name} (the run folder was completed with "
               "what ran)", file=sys.stderr)
         return exc.exit_code

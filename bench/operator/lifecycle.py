@@ -24,6 +24,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from types import FrameType
 from typing import Any
@@ -69,10 +70,12 @@ def stop_on_signals() -> None:
         signal.signal(s, handler)
 
 
-def supervise(pid: int) -> tuple[int, int | None]:
+def supervise(pid: int, meanwhile: Callable[[], None] | None = None) -> tuple[int, int | None]:
     """In the supervisor: wait for child ``pid``, forwarding stop signals to it.
 
-    Returns the child's wait status and the first stop signal received (None if none).
+    ``meanwhile`` runs first, with the signals already forwarded (the supervisor's own
+    work while the bench runs: loading the plotting library). Returns the child's wait
+    status and the first stop signal received (None if none).
     """
     received: list[int] = []
 
@@ -84,11 +87,31 @@ def supervise(pid: int) -> tuple[int, int | None]:
 
     previous = {s: signal.signal(s, forward) for s in STOP_SIGNALS}
     try:
+        if meanwhile is not None:
+            meanwhile()
         _, status = os.waitpid(pid, 0)  # retried after each handled signal (PEP 475)
     finally:
         for s, h in previous.items():
             signal.signal(s, h)
     return status, received[0] if received else None
+
+
+@contextlib.contextmanager
+def held_stop_signals() -> Iterator[list[int]]:
+    """In the supervisor, after the bench: stop signals received inside the block are
+    held, not acted on, so its work (the summary read, the plots) runs to the end; the
+    list yielded holds them, in order, for the caller to act on after the block."""
+    held: list[int] = []
+
+    def hold(signum: int, frame: FrameType | None) -> None:
+        held.append(signum)
+
+    previous = {s: signal.signal(s, hold) for s in STOP_SIGNALS}
+    try:
+        yield held
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
 
 
 class DiskReserve:

@@ -13,7 +13,12 @@ so a long run's plots cost what a short one's do.
 
 from __future__ import annotations
 
+import os
+import signal
+import sys
+import traceback
 from array import array
+from collections.abc import Callable
 from pathlib import Path
 
 import matplotlib
@@ -22,7 +27,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from bench.operator.lifecycle import STOP_SIGNALS
 from bench.results.record import read_lines, run_file
+from transport.lockstep import available_cpus
 
 RAD_DEG = 180.0 / np.pi
 DPI = 110
@@ -33,6 +40,17 @@ TELEMETRY_COLUMNS = ("t_s", "att_err_deg", "fsw_est_err_deg", "wx_rad_s", "wy_ra
                      "wz_rad_s")
 PULSE_COLUMNS = ("thruster", "t_on_s", "t_off_s")
 FLOAT64 = "d"
+# Fixed margins [in] (left, right, top, bottom): room for the tick labels, the axis labels
+# and the title. Measuring the text instead (tight_layout) cost ~40 % of the drawing time.
+MARGINS_IN = (0.8, 0.2, 0.4, 0.55)
+
+
+def _fixed_margins(fig: plt.Figure) -> None:
+    """Place the axes with :data:`MARGINS_IN` around them, whatever the figure's size."""
+    w, h = fig.get_size_inches()
+    left, right, top, bottom = MARGINS_IN
+    fig.subplots_adjust(left=left / w, right=1.0 - right / w, top=1.0 - top / h,
+                        bottom=bottom / h)
 
 
 def _read_columns(path: Path, wanted: tuple[str, ...]) -> tuple[list[str], dict[str, np.ndarray]]:
@@ -80,13 +98,62 @@ def envelope(t: np.ndarray, y: np.ndarray,
 
 
 def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
-    """Draw every plot of ``run_dir``; returns the written paths."""
-    head, tel = _read_columns(run_file(run_dir, "telemetry.csv"), TELEMETRY_COLUMNS)
-    out: list[Path] = []
-    if not tel or len(tel["t_s"]) == 0:
-        return out
-    t = tel["t_s"]
+    """Draw every plot of ``run_dir``; returns the written paths.
 
+    The figures are drawn by :func:`draw_each`: with more than one CPU, at the same time
+    (drawing is ~0.1 s a figure, most of it tick and text layout).
+    """
+    head, tel = _read_columns(run_file(run_dir, "telemetry.csv"), TELEMETRY_COLUMNS)
+    if not tel or len(tel["t_s"]) == 0:
+        return []
+    n_thr = sum(1 for k in head if k.startswith("thrust_T"))
+    _, pulses = _read_columns(run_file(run_dir, "valve_pulses.csv"), PULSE_COLUMNS)
+    return draw_each([
+        (run_dir / "attitude_error.png", lambda p: _attitude_error(p, tel, band_deg)),
+        (run_dir / "rates.png", lambda p: _rates(p, tel)),
+        (run_dir / "thruster_raster.png", lambda p: _raster(p, tel["t_s"], pulses, n_thr)),
+    ])
+
+
+def draw_each(figures: list[tuple[Path, Callable[[Path], None]]]) -> list[Path]:
+    """Write each figure's PNG with its drawer; returns the paths. With more than one CPU
+    the figures after the first are drawn in forked children at the same time (this
+    process has matplotlib loaded already, the children share it). A child that fails
+    makes this raise :class:`RuntimeError` naming the figure (its traceback is printed)."""
+    if len(figures) < 2 or not hasattr(os, "fork") or available_cpus() < 2:
+        for path, draw in figures:
+            draw(path)
+        return [path for path, _ in figures]
+    children: list[tuple[int, Path]] = []
+    for path, draw in figures[1:]:
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child reports through its exit status
+            code = 0
+            for s in STOP_SIGNALS:  # a stop reaches the parent, which waits for this figure
+                signal.signal(s, signal.SIG_IGN)
+            try:
+                draw(path)
+            except BaseException:
+                traceback.print_exc()
+                code = 1
+            finally:
+                sys.stderr.flush()
+                os._exit(code)
+        children.append((pid, path))
+    first, draw = figures[0]
+    try:
+        draw(first)
+    finally:
+        failed = [path.name for pid, path in children
+                  if os.waitpid(pid, 0)[1] != 0]
+    if failed:
+        raise RuntimeError(f"drawing {', '.join(failed)} failed (see the traceback above)")
+    return [path for path, _ in figures]
+
+
+def _attitude_error(path: Path, tel: dict[str, np.ndarray], band_deg: float | None) -> None:
+    """Attitude error (truth vs target, estimate vs truth), log scale, with the band."""
+    t = tel["t_s"]
     fig, ax = plt.subplots(figsize=(8, 4))
     ax.semilogy(*envelope(t, np.maximum(tel["att_err_deg"], ERROR_FLOOR_DEG)),
                 label="truth vs target")
@@ -103,11 +170,12 @@ def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     ax.set_title("Attitude error")
-    out.append(run_dir / "attitude_error.png")
-    fig.tight_layout()
-    fig.savefig(out[-1], dpi=DPI)
-    plt.close(fig)
+    _save(fig, path)
 
+
+def _rates(path: Path, tel: dict[str, np.ndarray]) -> None:
+    """Body rates (truth) [deg/s]."""
+    t = tel["t_s"]
     fig, ax = plt.subplots(figsize=(8, 4))
     for axis in "xyz":
         ax.plot(*envelope(t, tel[f"w{axis}_rad_s"] * RAD_DEG), label=f"omega_{axis}")
@@ -116,13 +184,11 @@ def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
     ax.grid(True, alpha=0.3)
     ax.legend()
     ax.set_title("Body rates (truth)")
-    out.append(run_dir / "rates.png")
-    fig.tight_layout()
-    fig.savefig(out[-1], dpi=DPI)
-    plt.close(fig)
+    _save(fig, path)
 
-    n_thr = sum(1 for k in head if k.startswith("thrust_T"))
-    _, pulses = _read_columns(run_file(run_dir, "valve_pulses.csv"), PULSE_COLUMNS)
+
+def _raster(path: Path, t: np.ndarray, pulses: dict[str, np.ndarray], n_thr: int) -> None:
+    """Commanded coil-on intervals per thruster over the run."""
     fig, ax = plt.subplots(figsize=(8, 0.35 * max(n_thr, 4) + 1.2))
     if pulses and len(pulses.get("t_on_s", [])):
         for k in range(n_thr):
@@ -134,8 +200,11 @@ def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
     ax.set_xlim(t[0], t[-1])
     ax.set_xlabel("time [s]")
     ax.set_title("Thruster firing raster (commanded coil-on intervals)")
-    out.append(run_dir / "thruster_raster.png")
-    fig.tight_layout()
-    fig.savefig(out[-1], dpi=DPI)
+    _save(fig, path)
+
+
+def _save(fig: plt.Figure, path: Path) -> None:
+    """Fixed margins, the PNG written, the figure freed."""
+    _fixed_margins(fig)
+    fig.savefig(path, dpi=DPI)
     plt.close(fig)
-    return out

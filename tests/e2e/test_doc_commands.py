@@ -86,6 +86,8 @@ PLANS: dict[str, Plan] = {
              why="runs until Ctrl-C: here the flight software of the bench-alone run above, "
              "on its channel, stopped (SIGTERM, exit 0) when that run has ended"),
     "thruster-hil report runs/a": Plan("run", "thruster-hil report runs/a", RUN_OR_FAIL),
+    "thruster-hil run scenarios/quickstart.toml --no-plots": Plan(
+        "run", f"{HIL_Q} --no-plots --bus {{private}} {SHORT} --out runs/noplots", RUN_OR_FAIL),
     "thruster-hil run scenarios/quickstart.toml --set bus.bitrate_bps=125000": Plan(
         "run", f"{HIL_Q} --set bus.bitrate_bps=125000 --bus {{private}} {SHORT} --out runs/slow",
         RUN_OR_FAIL),

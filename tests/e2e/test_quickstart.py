@@ -121,13 +121,15 @@ def test_trace_decodes_and_counters_advance_without_gaps(quickstart: Run) -> Non
 def test_full_record_is_the_standard_one_uncompressed(
     quickstart: Run, tmp_path: Path, runtime_dir: Path
 ) -> None:
-    """--record full writes the same trace and tables as plain text, and no .gz files."""
+    """--record full writes the same trace and tables as plain text, and no .gz files;
+    --no-plots (the same run) leaves out the PNGs only, and says the verdict all the same."""
     full = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--record", "full",
-                    "--duration", str(quickstart.summary["sim_time_s"])], tmp_path / "full",
-                   runtime_dir)
+                    "--no-plots", "--duration", str(quickstart.summary["sim_time_s"])],
+                   tmp_path / "full", runtime_dir)
     assert full.returncode == 0, full.stderr
     assert full.summary["record"] == "full" and quickstart.summary["record"] == "standard"
-    assert not list(full.out.glob("*.gz"))
+    assert not list(full.out.glob("*.gz")) and not list(full.out.glob("*.png"))
+    assert "verdict: PASS" in full.stdout and f"run folder: {full.out}" in full.stdout
     for name in ("telemetry.csv", "frames.csv", "chains.csv", "valve_pulses.csv"):
         assert (full.out / name).read_text() == run_text(quickstart.out, name), name
     assert trace_lines(full.out / "trace.asc") == trace_lines(quickstart.out / "trace.asc")

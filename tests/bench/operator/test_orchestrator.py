@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from bench.operator import orchestrator
+from bench.operator import bench_process, orchestrator
 from bench.operator.run_warnings import duration_warnings, overrun_warning
 from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError, RefusedConfigError
@@ -64,7 +64,7 @@ def test_bench_refusing_its_input_before_the_run_says_why(
     def refuse(*_args: object, **_kwargs: object) -> None:
         raise bad
 
-    monkeypatch.setattr(orchestrator, "BenchNode", refuse)
+    monkeypatch.setattr(bench_process, "BenchNode", refuse)
     sc = load_scenario(QUICKSTART)
     opts = orchestrator.RunOptions(mode="lockstep", bus=f"virtual:r-{uuid.uuid4().hex}",
                                    seed=1, out=tmp_path / "run", duration_s=1.0, fsw_cmd=None)

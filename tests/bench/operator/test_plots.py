@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from bench.operator.plots import MAX_PLOT_POINTS, _read_columns, envelope, plot_run
 from bench.results.telemetry import telemetry_columns
@@ -61,3 +62,21 @@ def test_plots_are_drawn_from_a_run_folder(tmp_path: Path) -> None:
     paths = plot_run(tmp_path, 0.1)
     assert [p.name for p in paths] == ["attitude_error.png", "rates.png", "thruster_raster.png"]
     assert all(p.stat().st_size > 0 for p in paths)
+
+
+def test_a_figure_that_fails_is_named_and_the_others_are_written(tmp_path: Path) -> None:
+    """draw_each: a drawer raising (in a forked child where there are CPUs for it, or
+    here) stops the call with the figure's name; the figures that could be drawn are."""
+    from bench.operator.plots import draw_each
+
+    def ok(path: Path) -> None:
+        path.write_bytes(b"png")
+
+    def broken(path: Path) -> None:
+        raise ValueError("no data")
+
+    figures = [(tmp_path / "a.png", ok), (tmp_path / "b.png", broken), (tmp_path / "c.png", ok)]
+    with pytest.raises((RuntimeError, ValueError), match=r"b\.png|no data"):
+        draw_each(figures)
+    assert (tmp_path / "a.png").exists() and (tmp_path / "c.png").exists()
+    assert draw_each([figures[0], figures[2]]) == [tmp_path / "a.png", tmp_path / "c.png"]

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from bench.operator.cli import _print_summary
+from bench.operator.console import print_summary
 
 BAND_DEG = 0.5
 
@@ -30,10 +30,10 @@ def test_not_converged_without_expectations_prints_a_fail_line(
     capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A run that did not converge says so in a FAIL line even with no expectations."""
-    _print_summary(_summary(converged=False, settling_time_s=None), Path("r"))
+    print_summary(_summary(converged=False, settling_time_s=None), Path("r"))
     out = capsys.readouterr().out
     assert f"FAIL converged: the attitude error did not end inside the {BAND_DEG:g} deg" in out
-    _print_summary(_summary(), Path("r"))
+    print_summary(_summary(), Path("r"))
     assert "FAIL" not in capsys.readouterr().out
 
 
@@ -41,7 +41,7 @@ def test_vacuous_settling_is_labelled(capsys: pytest.CaptureFixture[str]) -> Non
     """Settling 0 reads 'never left the band'; an expectation's note is printed after it."""
     row = {"name": "settling_time_s", "value": 0.0, "max": 20.0, "pass": True,
            "note": "never outside the 0.5 deg band"}
-    _print_summary(_summary(settling_time_s=0.0, expectations=[row]), Path("r"))
+    print_summary(_summary(settling_time_s=0.0, expectations=[row]), Path("r"))
     out = capsys.readouterr().out
     assert "settling 0.00 s (never left the band)" in out
     assert "PASS settling_time_s = 0.0000 (max 20.0; never outside the 0.5 deg band)" in out
