@@ -35,3 +35,21 @@ def test_good_configuration_checks_ok_and_writes_no_refusal(tmp_path: Path) -> N
     stats = tmp_path / "fsw_stats.json"
     assert main(["--config", str(config), "--check", "--stats", str(stats)]) == 0
     assert not stats.exists()
+
+
+def test_flight_software_runs_blas_on_one_thread_unless_told_otherwise() -> None:
+    """Loading the entry point sets OPENBLAS_NUM_THREADS=1 before numpy starts its threads
+    (the process keeps one OS thread); a value already in the environment is kept."""
+    import os
+    import subprocess
+    import sys
+
+    probe = ("import os, flight_sw.__main__, numpy; "
+             "print(os.environ['OPENBLAS_NUM_THREADS'], len(os.listdir('/proc/self/task')))")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
+                         text=True, check=True).stdout.split()
+    assert out == ["1", "1"]
+    out = subprocess.run([sys.executable, "-c", probe], env={**env, "OPENBLAS_NUM_THREADS": "2"},
+                         capture_output=True, text=True, check=True).stdout.split()
+    assert out[0] == "2"
