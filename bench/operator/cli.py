@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.operator.console import print_summary, progress_printer
+from bench.operator.junit import write_junit
 from bench.operator.lifecycle import Stopped
 from bench.results.record import RECORD_CHOICES, RECORD_STANDARD
 from dbc import options as opt
@@ -43,6 +44,7 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
     from bench.operator.run_warnings import scenario_warnings
     from bench.scenario.load import load_scenario
 
+    junit = _junit_path(args.junit)  # before any folder is made
     sc = load_scenario(args.scenario, args.overrides)
     for w in scenario_warnings(sc):  # said before the run too, not only in its summary
         print(f"thruster-hil: warning: {w}", file=sys.stderr)
@@ -86,11 +88,35 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         sys.stdout.flush()
         printed.append(True)
 
-    summary = run_scenario(sc, opts, progress_printer(), ready if alone else None,
-                           alerts.printer(), show)
+    try:
+        summary = run_scenario(sc, opts, progress_printer(), ready if alone else None,
+                               alerts.printer(), show)
+    except BaseException as exc:  # a failed or stopped run is a CI result too
+        if junit is not None:
+            write_junit(junit, opts.out, sc.name, f"{type(exc).__name__}: {exc}")
+        raise
+    if junit is not None:
+        write_junit(junit, opts.out, sc.name)
     if not printed:
         show(summary)
     return EXIT_OK if summary["passed"] else EXIT_FAILED
+
+
+def _junit_path(value: str | None) -> Path | None:
+    """``--junit FILE``: a file path whose folder exists or can be made (as pytest's
+    --junitxml does), checked before the run."""
+    if value is None:
+        return None
+    path = Path(value)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError("command line", "--junit", value,
+                          f"a file in a folder this user can create ({exc.strerror or exc})"
+                          ) from exc
+    if path.is_dir():
+        raise ConfigError("command line", "--junit", value, "a file path, not a folder")
+    return path
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
@@ -103,9 +129,13 @@ def _cmd_report(args: argparse.Namespace) -> int:
     s = parse_json(read_text(path, "summary.json", MAX_SUMMARY_BYTES), str(path))
     if not isinstance(s, dict):
         raise ConfigError(str(path), "<root>", s, "a summary.json written by thruster-hil")
+    junit = _junit_path(args.junit)
     try:
         for p in plot_run(run_dir, s.get("settling_band_deg")):
             print(f"wrote {p}")
+        if junit is not None:
+            write_junit(junit, run_dir)
+            print(f"wrote {junit}")
         print_summary(s, run_dir)
     except KeyError as exc:
         raise ConfigError(str(path), str(exc.args[0]), None, "a summary.json written by "
@@ -228,6 +258,10 @@ def build_parser() -> argparse.ArgumentParser:
                        "drawing); `thruster-hil report RUN_DIR` draws them later")
         r.add_argument("--replace", action="store_true",
                        help="let --out name a folder holding an earlier run, which is deleted")
+        r.add_argument("--junit", type=opt.text("--junit", "a file path"), metavar="FILE",
+                       help="also write the run's checks as JUnit XML (one test case per "
+                       "expectation, with its requirement ID) for a CI server; written "
+                       "whatever way the run ends")
         r.add_argument("--duration", type=opt.number("--duration", control_period_s,
                                                      MAX_DURATION_S, unit="s"),
                        help="override the scenario duration [s] (one control period to "
@@ -245,6 +279,8 @@ def build_parser() -> argparse.ArgumentParser:
     rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
     rp.add_argument("run_dir", metavar="RUN_DIR", type=opt.text("RUN_DIR", "a run folder"),
                     help="a run folder (with summary.json), as `run --out` names it")
+    rp.add_argument("--junit", type=opt.text("--junit", "a file path"), metavar="FILE",
+                    help="also write the run's checks as JUnit XML (as `run --junit`)")
     _add_timing_parser(sub)
     inj = sub.add_parser("inject", help="inject or clear a fault live on a running bench "
                          "(a FAULT_CMD frame, acknowledged by the bench)")

@@ -78,12 +78,16 @@ def print_summary(s: dict[str, Any], out: Path) -> None:
         f"bench late {dm.get('bench_late', 0)}",
     ]
     lines = [x for x in lines if x]
+    reqs = s.get("requirements") or {}
     if not s["converged"]:  # a run fails on this alone, with or without expectations
-        lines.append(f"  FAIL converged: the attitude error did not end inside the "
+        req = f" [{reqs['converged']}]" if reqs.get("converged") else ""
+        lines.append(f"  FAIL converged{req}: the attitude error did not end inside the "
                      f"{_fmt(s.get('settling_band_deg'), 'g')} deg settling band")
     for e in s["expectations"]:
-        lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']} = {_fmt(e['value'])} "
-                     f"(max {e['max']}{'; ' + e['note'] if e.get('note') else ''})")
+        req = f" [{e['req']}]" if e.get("req") else ""
+        lines.append(f"  {'PASS' if e['pass'] else 'FAIL'} {e['name']}{req} = "
+                     f"{_fmt(e['value'])} (max {e['max']}"
+                     f"{'; ' + e['note'] if e.get('note') else ''})")
     for w in s.get("warnings", []):
         lines.append(f"  WARNING {w}")
     if "error" in s:

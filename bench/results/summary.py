@@ -4,7 +4,9 @@ In: the scenario (expectations: limits) and the streamed attitude [deg], rate [d
 position [m] error figures from the manoeuvre's start (bench.results.error_stats, fed by
 bench.results.telemetry). Out: the summary.json fields ``converged``, settling times [s],
 steady-state and final errors, and ``expectations`` (one row per limit the scenario sets:
-value, limit, pass). Definitions in bench.results.error_stats.
+value, limit, pass, and ``req``, the requirement ID, where the scenario names one) with
+``requirements`` (every row's ID, ``converged`` too). Definitions in
+bench.results.error_stats.
 """
 
 from __future__ import annotations
@@ -56,8 +58,15 @@ def expectations_and_metrics(sc: Scenario, errors: ErrorStats) -> dict[str, Any]
         "position_settling_time_s": pos_settling,
         "rate_settling_band_deg_s": e.rate_settling_band_deg_s,
         "rate_settling_time_s": rate_settling,
-        "expectations": [x for x in rows if x is not None],
+        "expectations": [_with_requirement(x, e.requirement(x["name"])) for x in rows
+                         if x is not None],
+        "requirements": dict(e.requirements),  # row name -> requirement ID (and "converged")
     }
+
+
+def _with_requirement(row: dict[str, Any], req: str | None) -> dict[str, Any]:
+    """The expectation row with ``req`` (the requirement ID it verifies) when there is one."""
+    return row if req is None else {**row, "req": req}
 
 
 def net_translation(sc: Scenario, r_end_N_m: tuple[float, ...],

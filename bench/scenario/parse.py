@@ -15,6 +15,7 @@ from typing import Any
 
 from cantools.database.can import Database
 
+from bench.scenario.expectations import parse_expectations
 from bench.scenario.limits import MAX_DURATION_S, NS_PER_S, PERIOD_MESSAGE, SEED_MAX
 from bench.scenario.spec import (
     EVENT_KINDS,
@@ -25,7 +26,6 @@ from bench.scenario.spec import (
     CaptureSpec,
     DynamicsSpec,
     EnvironmentSpec,
-    Expectations,
     GyroSpec,
     MassSpec,
     Quat,
@@ -196,8 +196,6 @@ def _sensors(
     return gyro, accel, st, nav
 
 
-def _opt(t: Table, key: str) -> float | None:
-    return t.number(key, lo=0.0) if t.has(key) else None
 
 
 
@@ -342,30 +340,7 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
         frozenset(m.name for m in db.messages), frozenset(n.name for n in db.nodes),
     )
 
-    et = root.table("expectations", {})
-    exp = Expectations(
-        settling_band_deg=et.number("settling_band_deg", 0.5, lo=0.0, lo_open=True),
-        settling_time_s_max=_opt(et, "settling_time_s_max"),
-        steady_state_attitude_error_deg_max=_opt(et, "steady_state_attitude_error_deg_max"),
-        steady_state_rate_error_deg_s_max=_opt(et, "steady_state_rate_error_deg_s_max"),
-        steady_state_position_error_m_max=_opt(et, "steady_state_position_error_m_max"),
-        final_position_error_m_max=_opt(et, "final_position_error_m_max"),
-        position_band_m=et.number("position_band_m", lo=0.0, lo_open=True)
-        if et.has("position_band_m") else None,
-        position_settling_time_s_max=_opt(et, "position_settling_time_s_max"),
-        rate_settling_band_deg_s=et.number("rate_settling_band_deg_s", lo=0.0, lo_open=True)
-        if et.has("rate_settling_band_deg_s") else None,
-        rate_settling_time_s_max=_opt(et, "rate_settling_time_s_max"),
-        steady_state_window_s=et.number(
-            "steady_state_window_s", 10.0, lo=0.0, lo_open=True, hi=duration_s
-        ),
-    )
-    for key, band in (("position_settling_time_s_max", "position_band_m"),
-                      ("rate_settling_time_s_max", "rate_settling_band_deg_s")):
-        if et.has(key) and not et.has(band):
-            raise et.error(key, et.raw(key, None), f"set together with {band} (the band it "
-                           "settles into)")
-    et.done()
+    exp = parse_expectations(root.table("expectations", {}), duration_s)
     root.done()
     return Scenario(
         path=source,

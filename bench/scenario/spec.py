@@ -147,6 +147,12 @@ class Expectations:
     position_settling_time_s_max: float | None = None
     rate_settling_band_deg_s: float | None = None
     rate_settling_time_s_max: float | None = None
+    # (expectation row name, requirement ID) pairs: "settling_time_s", ..., "converged"
+    requirements: tuple[tuple[str, str], ...] = ()
+
+    def requirement(self, name: str) -> str | None:
+        """The requirement ID the scenario gives the expectation row ``name``, if any."""
+        return dict(self.requirements).get(name)
 
 
 @dataclass(frozen=True)

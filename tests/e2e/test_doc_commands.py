@@ -88,6 +88,9 @@ PLANS: dict[str, Plan] = {
     "thruster-hil report runs/a": Plan("run", "thruster-hil report runs/a", RUN_OR_FAIL),
     "thruster-hil run scenarios/quickstart.toml --no-plots": Plan(
         "run", f"{HIL_Q} --no-plots --bus {{private}} {SHORT} --out runs/noplots", RUN_OR_FAIL),
+    "thruster-hil run scenarios/quickstart.toml --junit runs/results.xml": Plan(
+        "run", f"{HIL_Q} --junit runs/results.xml --no-plots --bus {{private}} {SHORT} "
+        "--out runs/junit", RUN_OR_FAIL),
     "thruster-hil run scenarios/quickstart.toml --set bus.bitrate_bps=125000": Plan(
         "run", f"{HIL_Q} --set bus.bitrate_bps=125000 --bus {{private}} {SHORT} --out runs/slow",
         RUN_OR_FAIL),

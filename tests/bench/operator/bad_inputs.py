@@ -86,6 +86,15 @@ ROWS: list[Row] = [
     _run("--bus hilbus", "thruster-hil: error: command line: --bus = 'hilbus': expected "
          "INTERFACE:CHANNEL[?key=value&...], e.g. socketcan:vcan0 or hilbus:default"),
     _run("--out ''", "thruster-hil: error: command line: --out = '': expected a folder path"),
+    _run("--junit scenarios", "thruster-hil: error: command line: --junit = 'scenarios': "
+         "expected a file path, not a folder"),
+    _run("--junit ''", "thruster-hil: error: command line: --junit = '': expected a file path"),
+    _run("--set 'expectations.settling_time_s_max={max=5.0, req=\"has space\"}'",
+         "thruster-hil: error: command line --set expectations.settling_time_s_max={max=5.0, "
+         "req=\"has space\"} (on scenarios/quickstart.toml): "
+         "expectations.settling_time_s_max.req = 'has space': expected a requirement ID: 1 "
+         "to 64 letters, digits or . _ : / -, starting with a letter or digit (e.g. "
+         "\"GNC-ATT-012\")"),
     _run("--fsw-cmd ''", "thruster-hil: error: command line: --fsw-cmd = '': expected a "
          "command line"),
     _run("--nosuch", "thruster-hil: error: unrecognized arguments: --nosuch"),
