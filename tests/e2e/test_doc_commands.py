@@ -86,6 +86,8 @@ PLANS: dict[str, Plan] = {
              why="runs until Ctrl-C: here the flight software of the bench-alone run above, "
              "on its channel, stopped (SIGTERM, exit 0) when that run has ended"),
     "thruster-hil report runs/a": Plan("run", "thruster-hil report runs/a", RUN_OR_FAIL),
+    "thruster-hil export runs/a --format csv": Plan("run", "thruster-hil export runs/a "
+                                                    "--format csv"),
     "thruster-hil run scenarios/quickstart.toml --no-plots": Plan(
         "run", f"{HIL_Q} --no-plots --bus {{private}} {SHORT} --out runs/noplots", RUN_OR_FAIL),
     "thruster-hil run scenarios/quickstart.toml --junit runs/results.xml": Plan(

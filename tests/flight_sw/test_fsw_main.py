@@ -38,14 +38,22 @@ def test_good_configuration_checks_ok_and_writes_no_refusal(tmp_path: Path) -> N
 
 
 def test_flight_software_runs_blas_on_one_thread_unless_told_otherwise() -> None:
-    """Loading the entry point sets OPENBLAS_NUM_THREADS=1 before numpy starts its threads
-    (the process keeps one OS thread); a value already in the environment is kept."""
+    """Loading the entry point sets OPENBLAS_NUM_THREADS=1 before numpy loads OpenBLAS
+    (asked of the loaded OpenBLAS itself); a value already in the environment is kept."""
     import os
     import subprocess
     import sys
 
-    probe = ("import os, flight_sw.__main__, numpy; "
-             "print(os.environ['OPENBLAS_NUM_THREADS'], len(os.listdir('/proc/self/task')))")
+    probe = (
+        "import ctypes, os, flight_sw.__main__, numpy\n"
+        "path = next(ln.split()[-1] for ln in open('/proc/self/maps')\n"
+        "            if 'openblas' in ln and ln.split()[-1].endswith('.so'))\n"
+        "lib = ctypes.CDLL(path)\n"
+        "names = ('scipy_openblas_get_num_threads64_', 'openblas_get_num_threads64_',\n"
+        "         'openblas_get_num_threads')\n"
+        "get = next(getattr(lib, n) for n in names if hasattr(lib, n))\n"
+        "print(os.environ['OPENBLAS_NUM_THREADS'], get())\n"
+    )
     env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
     out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
                          text=True, check=True).stdout.split()

@@ -182,6 +182,11 @@ ROWS: list[Row] = [
        shown="report empty  # its summary.json: {}"),
     _r(HIL, "report ''", "thruster-hil: error: command line: RUN_DIR = '': expected a run "
        "folder"),
+    # thruster-hil export
+    _r(HIL, "export missing", "thruster-hil: error: missing: trace.asc = None: expected a run "
+       "folder with its CAN trace"),
+    _r(HIL, "export missing --format xls", "thruster-hil: error: command line: --format = "
+       "'xls': expected one of mf4, csv"),
     # thruster-hil timing
     _r(HIL, "timing", "thruster-hil: error: timing: RUN_DIR/--live = None: expected a run "
        "folder or --live"),

@@ -8,12 +8,14 @@ from pathlib import Path
 
 import can
 
+from bench.results.record import RECORD_STANDARD
 from bench.results.writers import TelemetryWriter
-from bench.wire.trace import TraceRecorder
+from bench.wire.trace import BLF_NAME, TraceRecorder
 
 START_WALL_S = 1_780_000_000.25  # a wall-clock instant in 2026
 T_FRAME_NS = 500_000_000
 FRAME_ID = 0x123
+ASC_RESOLUTION_S = 1e-6  # the ASC trace's timestamps have 6 decimals
 
 
 def test_trigger_block_is_dated_at_the_run_start_and_frames_keep_run_time(tmp_path: Path) -> None:
@@ -80,3 +82,30 @@ def test_deferred_rows_wait_for_write_pending_and_events_do_not(tmp_path: Path) 
     rec.flush()
     assert len(list(can.LogReader(tmp_path / "trace.asc"))) == 1
     rec.close()
+
+
+def test_blf_holds_the_frames_of_the_asc_trace(tmp_path: Path) -> None:
+    """--record full: trace.blf reads back with python-can as the ASC trace's frames (ID,
+    data, direction, error frames; times to the ASC's microsecond, exact in the BLF), and
+    deferred writing gives the same BLF bytes (no wall clock in it)."""
+    rec = _record_a_run(tmp_path / "now", deferred=False)
+    _record_a_run(tmp_path / "later", deferred=True)
+    asc = list(can.LogReader(tmp_path / "now" / "trace.asc"))
+    blf = list(can.LogReader(tmp_path / "now" / BLF_NAME))
+    assert len(blf) == len(asc) == rec.frames_written
+    for a, b in zip(asc, blf, strict=True):
+        assert (a.arbitration_id, bytes(a.data), a.is_rx, a.is_error_frame) == (
+            b.arbitration_id, bytes(b.data), b.is_rx, b.is_error_frame)
+        assert abs(a.timestamp - b.timestamp) <= ASC_RESOLUTION_S
+    assert [round(m.timestamp * 1e9) for m in blf if not m.is_error_frame][:2] == [0, 3]
+    assert (tmp_path / "now" / BLF_NAME).read_bytes() == (tmp_path / "later" / BLF_NAME
+                                                          ).read_bytes()
+
+
+def test_standard_record_writes_no_blf(tmp_path: Path) -> None:
+    """The default level keeps the folder small: the compressed ASC trace, no BLF."""
+    rec = TraceRecorder(tmp_path, START_WALL_S, record=RECORD_STANDARD)
+    rec.frame(can.Message(arbitration_id=FRAME_ID, data=b"\x01", is_extended_id=False),
+              T_FRAME_NS, tx=True)
+    rec.close()
+    assert (tmp_path / "trace.asc.gz").exists() and not (tmp_path / BLF_NAME).exists()

@@ -1,0 +1,177 @@
+"""Decoded export of a run's CAN trace: one channel per DBC signal, in physical units.
+
+In: a run folder's trace (``trace.asc`` or ``trace.asc.gz``, read with python-can's
+``LogReader``) and the CAN database (``dbc/thruster_hil.dbc``, cantools: scaling, offsets
+and units). Out, ``thruster-hil export RUN_DIR --format ...``:
+
+- ``mf4``: an ASAM MDF 4.10 file (asammdf, the optional extra ``[mf4]``): one channel
+  group per DBC message, one channel per signal named ``MESSAGE.SIGNAL`` with the DBC's
+  unit and comment, time = run time [s]. Every signal of the DBC has its channel, empty
+  for a message the run never carried, so scripts see the same channels in every file.
+- ``csv``: a folder with one CSV per message that occurs: ``t_s``, ``direction``
+  (``Rx``/``Tx`` as the bench saw it), then one column per signal headed
+  ``SIGNAL [unit]``.
+
+Every frame of the trace is decoded as it was on the wire, the bench's and the flight
+software's alike (a frame the receiver rejected, e.g. for its CRC, is still exported:
+the trace is what was on the bus). Error frames, remote frames, frames whose ID is not in
+the DBC and frames that do not decode (length) are skipped and counted in the result.
+Memory: the values are kept per signal as packed 8-byte arrays.
+"""
+
+from __future__ import annotations
+
+import csv
+from array import array
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import can
+from cantools.database.can import Database
+
+from bench.results.record import run_file
+from dbc.errors import ConfigError
+
+FORMATS = ("mf4", "csv")
+FLOAT64 = "d"
+MDF_VERSION = "4.10"
+
+
+@dataclass
+class _Series:
+    """One message's decoded values: times [s], directions and one array per signal."""
+
+    t_s: array[float] = field(default_factory=lambda: array(FLOAT64))
+    rx: list[bool] = field(default_factory=list)
+    values: dict[str, array[float]] = field(default_factory=dict)
+
+
+@dataclass
+class Decoded:
+    """A run's trace decoded per message, and what could not be (counts by reason)."""
+
+    series: dict[str, _Series]
+    frames: int = 0
+    skipped: dict[str, int] = field(default_factory=dict)
+
+
+def decode_trace(run_dir: Path, db: Database) -> Decoded:
+    """Every frame of ``run_dir``'s trace decoded with ``db`` (module docstring)."""
+    path = run_file(run_dir, "trace.asc")
+    if not path.exists():
+        raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace")
+    by_id = {m.frame_id: m for m in db.messages}
+    out = Decoded({m.name: _Series(values={s.name: array(FLOAT64) for s in m.signals})
+                   for m in db.messages})
+
+    def skip(why: str) -> None:
+        out.skipped[why] = out.skipped.get(why, 0) + 1
+
+    for msg in can.LogReader(str(path)):
+        if msg.is_error_frame or msg.is_remote_frame:
+            skip("error or remote frame")
+            continue
+        spec = by_id.get(msg.arbitration_id) if not msg.is_extended_id else None
+        if spec is None:
+            skip("ID not in the DBC")
+            continue
+        try:
+            decoded = spec.decode(bytes(msg.data), decode_choices=False)
+        except Exception:  # cantools raises several kinds for a frame it cannot decode
+            skip("does not decode")
+            continue
+        if not isinstance(decoded, dict):  # a container message: none in this DBC
+            skip("does not decode")
+            continue
+        s = out.series[spec.name]
+        s.t_s.append(msg.timestamp)
+        s.rx.append(bool(msg.is_rx))
+        for name, col in s.values.items():
+            value = decoded[name]  # decode_choices=False: numbers only
+            col.append(float(value) if isinstance(value, (int, float)) else float("nan"))
+        out.frames += 1
+    return out
+
+
+def write_csv(decoded: Decoded, db: Database, folder: Path) -> list[Path]:
+    """One CSV per message that occurs (module docstring); returns the paths written."""
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for m in db.messages:
+        s = decoded.series[m.name]
+        if not len(s.t_s):
+            continue
+        path = folder / f"{m.name}.csv"
+        with open(path, "w", newline="", encoding="utf-8") as f:
+            w = csv.writer(f)
+            w.writerow(["t_s", "direction"] + [
+                f"{sig.name} [{sig.unit}]" if sig.unit else sig.name for sig in m.signals])
+            cols = [s.values[sig.name] for sig in m.signals]
+            for i, t in enumerate(s.t_s):
+                w.writerow([repr(t), "Rx" if s.rx[i] else "Tx", *(repr(c[i]) for c in cols)])
+        written.append(path)
+    return written
+
+
+def write_mf4(decoded: Decoded, db: Database, path: Path) -> Path:
+    """An MDF 4 file with one channel per DBC signal (module docstring)."""
+    try:
+        import numpy as np
+        from asammdf import MDF, Signal
+    except ImportError as exc:
+        raise ConfigError("command line", "--format", "mf4",
+                          "an installed asammdf (pip install 'thruster-hil[mf4]')") from exc
+    mdf = MDF(version=MDF_VERSION)
+    try:
+        for m in db.messages:
+            s = decoded.series[m.name]
+            t = np.frombuffer(s.t_s, dtype=float) if len(s.t_s) else np.zeros(0)
+            signals = [Signal(samples=np.frombuffer(s.values[sig.name], dtype=float)
+                              if len(t) else np.zeros(0), timestamps=t,
+                              name=f"{m.name}.{sig.name}", unit=sig.unit or "",
+                              comment=sig.comment or "") for sig in m.signals]
+            mdf.append(signals, comment=m.name)
+        mdf.save(path, overwrite=True)
+    finally:
+        mdf.close()
+    return path
+
+
+def add_parser(sub: Any) -> None:
+    """The ``export`` subcommand of ``thruster-hil`` (its options, each checked)."""
+    from dbc import options as opt
+
+    ex = sub.add_parser("export", help="decode a run's CAN trace into one channel per DBC "
+                        "signal, in physical units (MF4 or CSV)")
+    ex.add_argument("run_dir", metavar="RUN_DIR", type=opt.text("RUN_DIR", "a run folder"),
+                    help="a run folder (with its trace.asc or trace.asc.gz)")
+    ex.add_argument("--format", type=opt.choice("--format", FORMATS), default="mf4",
+                    metavar="{mf4,csv}",
+                    help="mf4: one ASAM MDF 4 file, a channel MESSAGE.SIGNAL per DBC "
+                    "signal (needs asammdf: pip install 'thruster-hil[mf4]'); csv: a folder "
+                    "with one CSV per message, a column per signal (default mf4)")
+    ex.add_argument("--out", type=opt.text("--out", "a file or folder path"),
+                    help="the MF4 file or the CSV folder (default: RUN_DIR/signals.mf4 or "
+                    "RUN_DIR/signals/)")
+
+
+def run(args: Any) -> int:
+    """``thruster-hil export``: decode, write, say what was written and what was skipped."""
+    from dbc.database import load_database
+
+    run_dir = Path(args.run_dir)
+    db = load_database()
+    decoded = decode_trace(run_dir, db)
+    if args.format == "mf4":
+        out = Path(args.out) if args.out else run_dir / "signals.mf4"
+        paths = [write_mf4(decoded, db, out)]
+    else:
+        paths = write_csv(decoded, db, Path(args.out) if args.out else run_dir / "signals")
+    n_signals = sum(len(m.signals) for m in db.messages)
+    skipped = ", ".join(f"{n} {why}" for why, n in sorted(decoded.skipped.items()))
+    print(f"decoded {decoded.frames} frames into {n_signals} DBC signals"
+          + (f"; skipped {skipped}" if skipped else ""))
+    for p in paths:
+        print(f"wrote {p}")
+    return 0
