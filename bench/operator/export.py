@@ -8,10 +8,13 @@ and units). Out, ``thruster-hil export RUN_DIR --format ...``:
   group per DBC message, one channel per signal named ``MESSAGE.SIGNAL`` with the DBC's
   unit and comment, time = run time [s]. Every signal of the DBC has its channel, empty
   for a message the run never carried, so scripts see the same channels in every file.
-- ``csv``: a folder with one CSV per message that occurs: ``t_s``, ``direction``
-  (``Rx``/``Tx`` as the bench saw it), then one column per signal headed
-  ``SIGNAL [unit]``.
+- ``csv`` (the default): a folder with one CSV per message that occurs: ``t_s``,
+  ``direction`` (``Tx``: sent by the bench; ``Rx``: received by it, i.e. sent by the
+  flight software or another node), then one column per signal headed ``SIGNAL [unit]``;
+  integer signals (scale 1, offset 0) as integers, the others with 15 significant digits.
+  Enumerations (the DBC's value tables: modes, fault kinds) stay numeric.
 
+A trace with no frame of the DBC is refused (a ConfigError: not a run's trace).
 Every frame of the trace is decoded as it was on the wire, the bench's and the flight
 software's alike (a frame the receiver rejected, e.g. for its CRC, is still exported:
 the trace is what was on the bus). Error frames, remote frames, frames whose ID is not in
@@ -22,6 +25,7 @@ Memory: the values are kept per signal as packed 8-byte arrays.
 from __future__ import annotations
 
 import csv
+import importlib.util
 from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,9 +37,11 @@ from cantools.database.can import Database
 from bench.results.record import run_file
 from dbc.errors import ConfigError
 
-FORMATS = ("mf4", "csv")
+FORMATS = ("csv", "mf4")
 FLOAT64 = "d"
 MDF_VERSION = "4.10"
+CSV_DIGITS = ".15g"  # significant digits of a scaled value in the CSV
+MF4_HINT = "an installed asammdf (pip install asammdf, or pip install -e \".[mf4]\" here)"
 
 
 @dataclass
@@ -58,6 +64,8 @@ class Decoded:
 
 def decode_trace(run_dir: Path, db: Database) -> Decoded:
     """Every frame of ``run_dir``'s trace decoded with ``db`` (module docstring)."""
+    if not run_dir.is_dir():
+        raise ConfigError("command line", "RUN_DIR", str(run_dir), "an existing run folder")
     path = run_file(run_dir, "trace.asc")
     if not path.exists():
         raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace")
@@ -91,7 +99,21 @@ def decode_trace(run_dir: Path, db: Database) -> Decoded:
             value = decoded[name]  # decode_choices=False: numbers only
             col.append(float(value) if isinstance(value, (int, float)) else float("nan"))
         out.frames += 1
+    if out.frames == 0:
+        skipped = ", ".join(f"{n} {why}" for why, n in sorted(out.skipped.items()))
+        raise ConfigError(str(path), "<frames>", skipped or "none",
+                          "a trace with frames of the CAN database (none decoded)")
     return out
+
+
+def _is_integer(sig: Any) -> bool:
+    """A signal whose physical values are its raw integers (scale 1, offset 0)."""
+    return not sig.is_float and sig.scale == 1 and sig.offset == 0
+
+
+def _text(value: float, integer: bool) -> str:
+    """A value in the CSV (module docstring)."""
+    return str(int(value)) if integer and value == value else format(value, CSV_DIGITS)
 
 
 def write_csv(decoded: Decoded, db: Database, folder: Path) -> list[Path]:
@@ -107,9 +129,10 @@ def write_csv(decoded: Decoded, db: Database, folder: Path) -> list[Path]:
             w = csv.writer(f)
             w.writerow(["t_s", "direction"] + [
                 f"{sig.name} [{sig.unit}]" if sig.unit else sig.name for sig in m.signals])
-            cols = [s.values[sig.name] for sig in m.signals]
+            cols = [(s.values[sig.name], _is_integer(sig)) for sig in m.signals]
             for i, t in enumerate(s.t_s):
-                w.writerow([repr(t), "Rx" if s.rx[i] else "Tx", *(repr(c[i]) for c in cols)])
+                w.writerow([format(t, CSV_DIGITS), "Rx" if s.rx[i] else "Tx",
+                            *(_text(c[i], integer) for c, integer in cols)])
         written.append(path)
     return written
 
@@ -120,8 +143,7 @@ def write_mf4(decoded: Decoded, db: Database, path: Path) -> Path:
         import numpy as np
         from asammdf import MDF, Signal
     except ImportError as exc:
-        raise ConfigError("command line", "--format", "mf4",
-                          "an installed asammdf (pip install 'thruster-hil[mf4]')") from exc
+        raise ConfigError("command line", "--format", "mf4", MF4_HINT) from exc
     mdf = MDF(version=MDF_VERSION)
     try:
         for m in db.messages:
@@ -146,11 +168,11 @@ def add_parser(sub: Any) -> None:
                         "signal, in physical units (MF4 or CSV)")
     ex.add_argument("run_dir", metavar="RUN_DIR", type=opt.text("RUN_DIR", "a run folder"),
                     help="a run folder (with its trace.asc or trace.asc.gz)")
-    ex.add_argument("--format", type=opt.choice("--format", FORMATS), default="mf4",
-                    metavar="{mf4,csv}",
-                    help="mf4: one ASAM MDF 4 file, a channel MESSAGE.SIGNAL per DBC "
-                    "signal (needs asammdf: pip install 'thruster-hil[mf4]'); csv: a folder "
-                    "with one CSV per message, a column per signal (default mf4)")
+    ex.add_argument("--format", type=opt.choice("--format", FORMATS), default="csv",
+                    metavar="{csv,mf4}",
+                    help="csv: a folder with one CSV per message, a column per signal with "
+                    "its unit; mf4: one ASAM MDF 4 file, a channel MESSAGE.SIGNAL per DBC "
+                    "signal (needs asammdf: pip install asammdf) (default csv)")
     ex.add_argument("--out", type=opt.text("--out", "a file or folder path"),
                     help="the MF4 file or the CSV folder (default: RUN_DIR/signals.mf4 or "
                     "RUN_DIR/signals/)")
@@ -161,13 +183,21 @@ def run(args: Any) -> int:
     from dbc.database import load_database
 
     run_dir = Path(args.run_dir)
+    if args.format == "mf4" and importlib.util.find_spec("asammdf") is None:
+        raise ConfigError("command line", "--format", "mf4", MF4_HINT)  # before decoding
     db = load_database()
     decoded = decode_trace(run_dir, db)
-    if args.format == "mf4":
-        out = Path(args.out) if args.out else run_dir / "signals.mf4"
-        paths = [write_mf4(decoded, db, out)]
-    else:
-        paths = write_csv(decoded, db, Path(args.out) if args.out else run_dir / "signals")
+    try:
+        if args.format == "mf4":
+            out = Path(args.out) if args.out else run_dir / "signals.mf4"
+            paths = [write_mf4(decoded, db, out)]
+        else:
+            out = Path(args.out) if args.out else run_dir / "signals"
+            paths = write_csv(decoded, db, out)
+    except OSError as exc:
+        raise ConfigError("command line", "--out", str(out),
+                          f"a {'file' if args.format == 'mf4' else 'folder'} this user can "
+                          f"write ({exc.strerror or exc})") from exc
     n_signals = sum(len(m.signals) for m in db.messages)
     skipped = ", ".join(f"{n} {why}" for why, n in sorted(decoded.skipped.items()))
     print(f"decoded {decoded.frames} frames into {n_signals} DBC signals"

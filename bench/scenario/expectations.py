@@ -42,7 +42,7 @@ def _limit(t: Table, key: str, reqs: dict[str, str]) -> float | None:
         return t.number(key, lo=0.0)
     sub = t.table(key)
     limit = sub.number("max", lo=0.0)
-    if sub.has("req"):
+    if sub.raw("req", None) is not None:
         reqs[key.removesuffix(LIMIT_SUFFIX)] = _requirement(sub, "req")
     sub.done()
     return limit

@@ -183,10 +183,10 @@ ROWS: list[Row] = [
     _r(HIL, "report ''", "thruster-hil: error: command line: RUN_DIR = '': expected a run "
        "folder"),
     # thruster-hil export
-    _r(HIL, "export missing", "thruster-hil: error: missing: trace.asc = None: expected a run "
-       "folder with its CAN trace"),
+    _r(HIL, "export missing", "thruster-hil: error: command line: RUN_DIR = 'missing': "
+       "expected an existing run folder"),
     _r(HIL, "export missing --format xls", "thruster-hil: error: command line: --format = "
-       "'xls': expected one of mf4, csv"),
+       "'xls': expected one of csv, mf4"),
     # thruster-hil timing
     _r(HIL, "timing", "thruster-hil: error: timing: RUN_DIR/--live = None: expected a run "
        "folder or --live"),

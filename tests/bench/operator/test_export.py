@@ -60,7 +60,9 @@ def test_csv_has_a_column_per_signal_with_its_unit(tmp_path: Path) -> None:
     assert rows[0][:2] == ["t_s", "direction"] and "RateX [rad/s]" in rows[0]
     assert len(rows[0]) == 2 + len(imu.signals)
     col = rows[0].index("RateX [rad/s]")
-    assert [float(r[col]) for r in rows[1:]] == [v["RateX"] for v in sent]
+    assert [r[col] for r in rows[1:]] == [format(v["RateX"], ".15g") for v in sent]
+    counter = rows[0].index("AliveCounter")
+    assert [r[counter] for r in rows[1:]] == [str(k) for k in range(N_SAMPLES)]  # integers
     assert {r[1] for r in rows[1:]} == {"Tx"}
 
 
@@ -77,3 +79,12 @@ def test_mf4_has_one_channel_per_dbc_signal(tmp_path: Path) -> None:
         rate = mdf.get("IMU_RATE.RateX")
         assert rate.unit == "rad/s" and list(rate.samples) == [v["RateX"] for v in sent]
         assert list(rate.timestamps) == [k * 0.01 for k in range(N_SAMPLES)]
+
+
+def test_a_trace_with_no_frame_of_the_dbc_is_refused(tmp_path: Path) -> None:
+    """A folder whose trace decodes to nothing (not a run's trace): ConfigError, by name."""
+    from dbc.errors import ConfigError
+
+    (tmp_path / "trace.asc").write_text("garbage\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match="none decoded"):
+        decode_trace(tmp_path, load_database())
