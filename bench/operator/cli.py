@@ -3,7 +3,8 @@
 Subcommands: ``run SCENARIO`` (bench + flight software as two processes, lockstep or
 realtime), ``bench SCENARIO`` (the bench alone, for external flight software or hardware
 on the same bus), ``report RUN_DIR`` (redraw plots, print the summary), ``export RUN_DIR``
-(decoded signals: MF4 or CSV), ``timing RUN_DIR``
+(decoded signals: MF4 or CSV), ``replay RUN_DIR`` (a recorded run into a new flight
+software, compared), ``timing RUN_DIR``
 (per-message timing, chains, bus load, worst-case bounds; ``timing --live --bus SPEC``
 measures a running bus). Exit codes: 0 pass, 1 the run's expectations failed (``timing
 --strict``: a measured latency above its bound, or a message sent but never received), 2
@@ -22,7 +23,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from bench.operator import export
+from bench.operator import export, replay
 from bench.operator.console import print_summary, progress_printer
 from bench.operator.junit import write_junit
 from bench.operator.lifecycle import Stopped
@@ -289,6 +290,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="also write the run's checks as JUnit XML (as `run --junit`)")
     _add_timing_parser(sub)
     export.add_parser(sub)
+    replay.add_parser(sub)
     inj = sub.add_parser("inject", help="inject or clear a fault live on a running bench "
                          "(a FAULT_CMD frame, acknowledged by the bench)")
     inj.add_argument("kind", type=opt.text("KIND", "a fault kind"),
@@ -448,6 +450,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             return _cmd_inject(args)
         if args.command == "export":
             return export.run(args)
+        if args.command == "replay":
+            return replay.run(args)
         if args.command == "campaign":
             return _cmd_campaign(args)
         return _cmd_run(args, alone=args.command == "bench")

@@ -88,6 +88,7 @@ PLANS: dict[str, Plan] = {
     "thruster-hil report runs/a": Plan("run", "thruster-hil report runs/a", RUN_OR_FAIL),
     "thruster-hil export runs/a --format csv": Plan("run", "thruster-hil export runs/a "
                                                     "--format csv"),
+    "thruster-hil replay runs/a": Plan("run", "thruster-hil replay runs/a"),
     "thruster-hil run scenarios/quickstart.toml --no-plots": Plan(
         "run", f"{HIL_Q} --no-plots --bus {{private}} {SHORT} --out runs/noplots", RUN_OR_FAIL),
     "thruster-hil run scenarios/quickstart.toml --junit runs/results.xml": Plan(

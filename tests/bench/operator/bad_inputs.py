@@ -187,6 +187,11 @@ ROWS: list[Row] = [
        "expected an existing run folder"),
     _r(HIL, "export missing --format xls", "thruster-hil: error: command line: --format = "
        "'xls': expected one of csv, mf4"),
+    # thruster-hil replay
+    _r(HIL, "replay missing", "thruster-hil: error: command line: RUN_DIR = 'missing': "
+       "expected an existing run folder"),
+    _r(HIL, "replay scenarios --external", "thruster-hil: error: command line: --bus = None: "
+       "expected the bus of the flight software already running (--external)"),
     # thruster-hil timing
     _r(HIL, "timing", "thruster-hil: error: timing: RUN_DIR/--live = None: expected a run "
        "folder or --live"),
