@@ -128,6 +128,7 @@ def _junit_path(value: str | None) -> Path | None:
 
 def _cmd_report(args: argparse.Namespace) -> int:
     from bench.operator.plots import plot_run
+    from bench.operator.report_html import event_marks, read_events, write_report
 
     run_dir = Path(args.run_dir)
     path = run_dir / "summary.json"
@@ -138,12 +139,14 @@ def _cmd_report(args: argparse.Namespace) -> int:
         raise ConfigError(str(path), "<root>", s, "a summary.json written by thruster-hil")
     junit = _junit_path(args.junit)
     try:
-        for p in plot_run(run_dir, s.get("settling_band_deg")):
+        marks = event_marks(read_events(run_dir))
+        for p in plot_run(run_dir, s.get("settling_band_deg"), marks):
             print(f"wrote {p}")
         if junit is not None:
             write_junit(junit, run_dir)
             print(f"wrote {junit}")
-        print_summary(s, run_dir)
+        print_summary(s, run_dir)  # a summary.json it cannot print stops here (exit 2)
+        print(f"wrote {write_report(run_dir)}")
     except KeyError as exc:
         raise ConfigError(str(path), str(exc.args[0]), None, "a summary.json written by "
                           "thruster-hil (this key is missing)") from exc
@@ -283,7 +286,8 @@ def build_parser() -> argparse.ArgumentParser:
                 help="flight-software command; placeholders {bus} {mode} "
                 "{config} {stats} {rx_log} {run_dir}",
             )
-    rp = sub.add_parser("report", help="redraw the plots of a run folder and print its summary")
+    rp = sub.add_parser("report", help="redraw the plots and report.html of a run folder and "
+                        "print its summary")
     rp.add_argument("run_dir", metavar="RUN_DIR", type=opt.text("RUN_DIR", "a run folder"),
                     help="a run folder (with summary.json), as `run --out` names it")
     rp.add_argument("--junit", type=opt.text("--junit", "a file path"), metavar="FILE",

@@ -194,9 +194,13 @@ def run_scenario(
 
 
 def _plots(opts: RunOptions, sc: Scenario) -> None:
-    """The run folder's PNG plots, unless ``--no-plots``."""
+    """The run folder's PNG plots and report.html (without figures at ``--no-plots``)."""
     if opts.plots:
         plot_folder(opts.out, sc)
+    else:
+        from bench.operator.report_html import write_report
+
+        write_report(opts.out)
 
 
 def _write_refusal(sc: Scenario, opts: RunOptions, refusal: ConfigError,

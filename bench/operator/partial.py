@@ -27,12 +27,14 @@ from dbc.icd import Icd
 
 
 def plot_folder(out: Path, sc: Scenario) -> None:
-    """The run's PNG plots, drawn by the supervisor once the bench is done (the bench
-    process never carries matplotlib's heap: tens of thousands of objects the garbage
-    collector would walk while it runs)."""
+    """The run's PNG plots, events marked, and report.html with them, drawn by the
+    supervisor once the bench is done (the bench process never carries matplotlib's heap:
+    tens of thousands of objects the garbage collector would walk while it runs)."""
     from bench.operator.plots import plot_run
+    from bench.operator.report_html import event_marks, read_events, write_report
 
-    plot_run(out, sc.expectations.settling_band_deg)
+    plot_run(out, sc.expectations.settling_band_deg, event_marks(read_events(out)))
+    write_report(out)
 
 
 def preload_plots() -> None:

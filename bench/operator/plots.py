@@ -13,12 +13,13 @@ so a long run's plots cost what a short one's do.
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import sys
 import traceback
 from array import array
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import matplotlib
@@ -43,6 +44,8 @@ FLOAT64 = "d"
 # Fixed margins [in] (left, right, top, bottom): room for the tick labels, the axis labels
 # and the title. Measuring the text instead (tight_layout) cost ~40 % of the drawing time.
 MARGINS_IN = (0.8, 0.2, 0.4, 0.55)
+AXES_SUFFIX = ".axes.json"  # beside a PNG: where its time axis lies (report.html)
+MAX_MARKED_EVENTS = 200  # events marked on a figure at most (report.html lists them all)
 
 
 def _fixed_margins(fig: plt.Figure) -> None:
@@ -97,21 +100,28 @@ def envelope(t: np.ndarray, y: np.ndarray,
     return t_out, y_out
 
 
-def plot_run(run_dir: Path, band_deg: float | None = None) -> list[Path]:
+def plot_run(run_dir: Path, band_deg: float | None = None,
+             events: Sequence[tuple[float, str]] = ()) -> list[Path]:
     """Draw every plot of ``run_dir``; returns the written paths.
 
     The figures are drawn by :func:`draw_each`: with more than one CPU, at the same time
-    (drawing is ~0.1 s a figure, most of it tick and text layout).
+    (drawing is ~0.1 s a figure, most of it tick and text layout). ``events`` (time [s],
+    name) are marked on every time axis: a dotted line and the event's number (the first
+    :data:`MAX_MARKED_EVENTS`). Beside each PNG, ``NAME.axes.json`` says where its time
+    axis lies in the picture (figure fractions and limits), for report.html's overlay.
     """
     head, tel = _read_columns(run_file(run_dir, "telemetry.csv"), TELEMETRY_COLUMNS)
     if not tel or len(tel["t_s"]) == 0:
         return []
     n_thr = sum(1 for k in head if k.startswith("thrust_T"))
     _, pulses = _read_columns(run_file(run_dir, "valve_pulses.csv"), PULSE_COLUMNS)
+    marks = list(events)[:MAX_MARKED_EVENTS]
     return draw_each([
-        (run_dir / "attitude_error.png", lambda p: _attitude_error(p, tel, band_deg)),
-        (run_dir / "rates.png", lambda p: _rates(p, tel)),
-        (run_dir / "thruster_raster.png", lambda p: _raster(p, tel["t_s"], pulses, n_thr)),
+        (run_dir / "attitude_error.png",
+         lambda p: _save(_attitude_error(tel, band_deg), p, marks)),
+        (run_dir / "rates.png", lambda p: _save(_rates(tel), p, marks)),
+        (run_dir / "thruster_raster.png",
+         lambda p: _save(_raster(tel["t_s"], pulses, n_thr), p, marks)),
     ])
 
 
@@ -151,7 +161,7 @@ def draw_each(figures: list[tuple[Path, Callable[[Path], None]]]) -> list[Path]:
     return [path for path, _ in figures]
 
 
-def _attitude_error(path: Path, tel: dict[str, np.ndarray], band_deg: float | None) -> None:
+def _attitude_error(tel: dict[str, np.ndarray], band_deg: float | None) -> plt.Figure:
     """Attitude error (truth vs target, estimate vs truth), log scale, with the band."""
     t = tel["t_s"]
     fig, ax = plt.subplots(figsize=(8, 4))
@@ -170,10 +180,10 @@ def _attitude_error(path: Path, tel: dict[str, np.ndarray], band_deg: float | No
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     ax.set_title("Attitude error")
-    _save(fig, path)
+    return fig
 
 
-def _rates(path: Path, tel: dict[str, np.ndarray]) -> None:
+def _rates(tel: dict[str, np.ndarray]) -> plt.Figure:
     """Body rates (truth) [deg/s]."""
     t = tel["t_s"]
     fig, ax = plt.subplots(figsize=(8, 4))
@@ -184,10 +194,10 @@ def _rates(path: Path, tel: dict[str, np.ndarray]) -> None:
     ax.grid(True, alpha=0.3)
     ax.legend()
     ax.set_title("Body rates (truth)")
-    _save(fig, path)
+    return fig
 
 
-def _raster(path: Path, t: np.ndarray, pulses: dict[str, np.ndarray], n_thr: int) -> None:
+def _raster(t: np.ndarray, pulses: dict[str, np.ndarray], n_thr: int) -> plt.Figure:
     """Commanded coil-on intervals per thruster over the run."""
     fig, ax = plt.subplots(figsize=(8, 0.35 * max(n_thr, 4) + 1.2))
     if pulses and len(pulses.get("t_on_s", [])):
@@ -200,11 +210,22 @@ def _raster(path: Path, t: np.ndarray, pulses: dict[str, np.ndarray], n_thr: int
     ax.set_xlim(t[0], t[-1])
     ax.set_xlabel("time [s]")
     ax.set_title("Thruster firing raster (commanded coil-on intervals)")
-    _save(fig, path)
+    return fig
 
 
-def _save(fig: plt.Figure, path: Path) -> None:
-    """Fixed margins, the PNG written, the figure freed."""
+def _save(fig: plt.Figure, path: Path, events: Sequence[tuple[float, str]] = ()) -> None:
+    """Events marked, fixed margins, the PNG and its axis placement written, figure freed."""
+    ax = fig.axes[0]
+    xlim = ax.get_xlim()  # the data's limits, before the markers could widen them
+    for i, (t_s, _) in enumerate(events):
+        ax.axvline(t_s, color="0.35", lw=0.7, ls=":")
+        ax.text(t_s, 1.0, str(i), transform=ax.get_xaxis_transform(), fontsize=6,
+                ha="center", va="bottom", color="0.35")
+    ax.set_xlim(xlim)
     _fixed_margins(fig)
     fig.savefig(path, dpi=DPI)
+    box = ax.get_position()
+    path.with_suffix(AXES_SUFFIX).write_text(json.dumps({
+        "xlim": list(xlim), "x_frac": [box.x0, box.x1], "y_frac": [box.y0, box.y1]}),
+        encoding="utf-8")
     plt.close(fig)

@@ -1,0 +1,98 @@
+"""report.html: self-contained, every event numbered and marked on each figure's time axis."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+from html.parser import HTMLParser
+from pathlib import Path
+
+import numpy as np
+
+from bench.operator.plots import AXES_SUFFIX, MAX_PLOT_POINTS, plot_run
+from bench.operator.report_html import FIGURES, event_marks, read_events, write_report
+from bench.results.telemetry import telemetry_columns
+
+EVENTS = [
+    {"event": "run_started", "mode": "lockstep", "t_s": 0.0},
+    {"event": "fault_injected", "kind": "stuck_open", "thruster": 2, "t_s": 5.0},
+    {"event": "fsw_mode", "mode": "SAFE", "note": "<b>&'\"", "t_s": 7.5},
+]
+
+
+class _Page(HTMLParser):
+    """Ids, image sources and links of a page."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.ids: set[str] = set()
+        self.srcs: list[str] = []
+        self.links: list[str] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        a = dict(attrs)
+        if a.get("id"):
+            self.ids.add(str(a["id"]))
+        if tag in ("img", "script") and a.get("src"):
+            self.srcs.append(str(a["src"]))
+        if a.get("href"):
+            self.links.append(str(a["href"]))
+
+
+def _run_folder(tmp_path: Path) -> Path:
+    cols = telemetry_columns(2)
+    n = 2 * MAX_PLOT_POINTS
+    data = np.zeros((n, len(cols)))
+    data[:, 0] = np.arange(n) * 0.01
+    data[:, cols.index("att_err_deg")] = np.exp(-data[:, 0])
+    with open(tmp_path / "telemetry.csv", "w", encoding="utf-8") as f:
+        f.write(",".join(cols) + "\n")
+        f.writelines(",".join(map(repr, row.tolist())) + "\n" for row in data)
+    (tmp_path / "valve_pulses.csv").write_text("thruster,t_on_s,t_off_s\n1,0.5,0.6\n")
+    (tmp_path / "events.jsonl").write_text("".join(json.dumps(e) + "\n" for e in EVENTS))
+    (tmp_path / "summary.json").write_text(json.dumps({
+        "scenario": "q", "verdict": "FAIL: converged", "abnormal": ["SAFE at 7.5 s"],
+        "converged": False, "expectations": [{"name": "settling_time_s", "value": None,
+                                              "max": 10.0, "pass": False, "req": "R-1"}]}))
+    return tmp_path
+
+
+def test_every_event_is_marked_on_every_figure_and_listed(tmp_path: Path) -> None:
+    """Markers FIGURE-event-N for each event and figure; the events table escapes their
+    text; the axis placement files are gone."""
+    run = _run_folder(tmp_path)
+    plot_run(run, 0.5, event_marks(read_events(run)))
+    text = write_report(run).read_text(encoding="utf-8")  # type: ignore[union-attr]
+    page = _Page()
+    page.feed(text)
+    for name, _ in FIGURES:
+        for i in range(len(EVENTS)):
+            assert f"{name}-event-{i}" in page.ids, (name, i)
+    assert "&lt;b&gt;&amp;" in text and "<b>&" not in text
+    assert "R-1" in text and "ABNORMAL SAFE at 7.5 s" in text
+    assert not list(run.glob("*" + AXES_SUFFIX))
+
+
+def test_the_page_fetches_nothing(tmp_path: Path) -> None:
+    """No script, no link, every image a data: URI holding the figure's PNG bytes."""
+    run = _run_folder(tmp_path)
+    plot_run(run, 0.5, event_marks(read_events(run)))
+    text = write_report(run).read_text(encoding="utf-8")  # type: ignore[union-attr]
+    page = _Page()
+    page.feed(text)
+    assert "<script" not in text and page.links == []
+    assert len(page.srcs) == len(FIGURES)
+    for src, (name, _) in zip(page.srcs, FIGURES, strict=True):
+        head, data = src.split(",", 1)
+        assert head == "data:image/png;base64"
+        assert base64.b64decode(data) == (run / f"{name}.png").read_bytes()
+    assert not re.search(r"(src|href)=['\"]https?:", text)
+
+
+def test_without_figures_the_report_says_so(tmp_path: Path) -> None:
+    """--no-plots: the report has its tables and says how to draw the figures."""
+    run = _run_folder(tmp_path)
+    text = write_report(run).read_text(encoding="utf-8")  # type: ignore[union-attr]
+    assert "no figures" in text and "thruster-hil report RUN_DIR" in text
+    assert "fault_injected" in text
