@@ -23,7 +23,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from bench.operator import export, replay
+from bench.operator import export, monitor, replay
 from bench.operator.console import print_summary, progress_printer
 from bench.operator.junit import write_junit
 from bench.operator.lifecycle import Stopped
@@ -295,6 +295,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_timing_parser(sub)
     export.add_parser(sub)
     replay.add_parser(sub)
+    monitor.add_parser(sub)
     inj = sub.add_parser("inject", help="inject or clear a fault live on a running bench "
                          "(a FAULT_CMD frame, acknowledged by the bench)")
     inj.add_argument("kind", type=opt.text("KIND", "a fault kind"),
@@ -456,6 +457,8 @@ def _dispatch(args: argparse.Namespace) -> int:
             return export.run(args)
         if args.command == "replay":
             return replay.run(args)
+        if args.command == "monitor":
+            return monitor.run(args)
         if args.command == "campaign":
             return _cmd_campaign(args)
         return _cmd_run(args, alone=args.command == "bench")

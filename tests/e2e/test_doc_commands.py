@@ -101,6 +101,10 @@ PLANS: dict[str, Plan] = {
     "thruster-hil timing --live --bus socketcan:can0 --duration 10": Plan(
         "live", "thruster-hil timing --live --bus {private} --duration 1",
         why="can0 is a hardware bus: the private channel of a running bench, listened to 1 s"),
+    "thruster-hil monitor --bus socketcan:can0": Plan(
+        "live", "thruster-hil monitor --bus {private} --duration 1",
+        why="can0 is a hardware bus: the private channel of a running bench, watched 1 s "
+        "(no terminal here: headless, the last picture printed)"),
     "python benchmarks/bus_roundtrip.py": Plan("run", "python benchmarks/bus_roundtrip.py"),
     "bash benchmarks/vcan_vm.sh": Plan(
         "skip", why="boots a QEMU guest for SocketCAN (minutes); CI's SocketCAN stage boots "

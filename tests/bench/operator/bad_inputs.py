@@ -187,6 +187,13 @@ ROWS: list[Row] = [
        "expected an existing run folder"),
     _r(HIL, "export missing --format xls", "thruster-hil: error: command line: --format = "
        "'xls': expected one of csv, mf4"),
+    # thruster-hil monitor
+    _r(HIL, "monitor --bus hilbus:x", "thruster-hil: error: command line: --duration = None: "
+       "expected a duration when the output is not a terminal (the monitor then prints its "
+       "last picture)", shown="monitor --bus hilbus:x  # output not a terminal"),
+    _r(HIL, "monitor --bus hilbus --duration 1", "thruster-hil: error: command line: --bus = "
+       "'hilbus': expected INTERFACE:CHANNEL[?key=value&...], e.g. socketcan:vcan0 or "
+       "hilbus:default"),
     # thruster-hil replay
     _r(HIL, "replay missing", "thruster-hil: error: command line: RUN_DIR = 'missing': "
        "expected an existing run folder"),

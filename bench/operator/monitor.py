@@ -1,0 +1,201 @@
+"""``thruster-hil monitor --bus SPEC``: a live, decoded view of a bus in the terminal (textual).
+
+In: every frame on any python-can bus (a run's channel, SocketCAN, an adapter on real
+hardware), read by a thread of its own into bench.operator.monitor_state, which checks and
+decodes it with the DBC. Out: a terminal console redrawn every ``--refresh`` seconds: the
+vehicle (flight-software mode, FDIR flags, failed thruster, estimated attitude, rates,
+position, the bench's time, health and faults), the bus load, a message table (ID, name,
+count, period, jitter, rejects by cause, last decoded signals), the thrusters (commanded and
+actual valve state, openings) and an event log. The reader never waits for the screen: a
+slow terminal skips redraws, never frames (the bus is read as fast as it delivers).
+``--duration`` ends it (also for scripts); without a terminal it runs headless and prints
+the last picture as text. Textual (terminal UI library, its own test driver in tests/);
+q quits.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any, ClassVar
+
+import can
+from cantools.database.can import Database
+
+from bench.operator.monitor_state import MonitorState
+from dbc.errors import ConfigError
+
+RECV_POLL_S = 0.1  # the reader's longest wait, so that it sees a stop request
+DEFAULT_REFRESH_S = 0.25
+SIGNALS_SHOWN = 4  # decoded signals of a message in its row (the E2E ones left out)
+E2E_SIGNALS = ("CRC", "AliveCounter")
+
+
+class BusReader:
+    """A thread that feeds every frame of ``bus`` into a :class:`MonitorState`."""
+
+    def __init__(self, bus: can.BusABC, state: MonitorState) -> None:
+        self.bus, self.state = bus, state
+        self.lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="monitor-reader", daemon=True)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._thread.join()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            msg = self.bus.recv(RECV_POLL_S)
+            if msg is not None:
+                with self.lock:
+                    self.state.feed(msg, time.monotonic_ns())  # the edge's clock
+
+    def snapshot(self) -> dict[str, Any]:
+        with self.lock:
+            return self.state.snapshot()
+
+
+def _fmt(x: Any, spec: str = ".3g") -> str:
+    return "-" if x is None else format(x, spec)
+
+
+def vehicle_text(s: dict[str, Any]) -> str:
+    """The vehicle and bus lines of a snapshot."""
+    v = s["vehicle"]
+    q = v.get("q_est")
+    lines = [
+        f"mode {v.get('mode', '-')}  FDIR {v.get('fdir', '-')}  failed thruster "
+        f"{v.get('failed_thruster', 'none')}  cycle {v.get('cycle', '-')}",
+        "q_est " + (" ".join(f"{c:+.5f}" for c in q) if q else "-")
+        + "   rates [deg/s] " + " ".join(_fmt(r, "+.4f") for r in v.get("rate_deg_s", ())),
+        "position [m] " + (" ".join(_fmt(p, "+.3f") for p in v["pos_m"]) if "pos_m" in v
+                           else "-")
+        + f"   bench t {_fmt(v.get('sim_time_s'), '.2f')} s  health {v.get('health', '-')}"
+        f"  faults {v.get('active_faults', '-')}",
+        f"bus load {100.0 * s['bus_load']:.1f} % of the last wall-clock second (lockstep: "
+        f"faster than real time)   frames {s['frames']}",
+    ]
+    return "\n".join(lines)
+
+
+def thruster_text(s: dict[str, Any]) -> str:
+    """One cell per thruster: commanded/actual valve, openings."""
+    cells = [f"T{t['thruster']:02d} {'C' if t['commanded'] else '.'}"
+             f"{'O' if t['open'] else '.'} {t['openings']:5d}" for t in s["thrusters"]]
+    return "thrusters (C commanded, O open, openings)\n" + "\n".join(
+        "   ".join(cells[i:i + 4]) for i in range(0, len(cells), 4))
+
+
+def message_rows(s: dict[str, Any]) -> list[tuple[str, ...]]:
+    """The message table's rows (the UI's and the text picture's)."""
+    rows: list[tuple[str, ...]] = []
+    for m in s["messages"]:
+        sig = ", ".join(f"{k}={v:.4g}" for k, v in m["last"].items()
+                        if k not in E2E_SIGNALS)
+        rows.append((f"0x{m['id']:03X}", m["name"], str(m["count"]), _fmt(m["period_ms"]),
+                     _fmt(m["jitter_ms"]),
+                     ", ".join(f"{c}={n}" for c, n in m["rejected"].items()) or "-",
+                     sig[:80]))
+    return rows
+
+
+COLUMNS = ("ID", "message", "count", "period ms", "jitter ms", "rejected", "last signals")
+
+
+def text_picture(s: dict[str, Any]) -> str:
+    """A snapshot as plain text (headless runs, scripts)."""
+    widths = [max(len(c), *(len(r[i]) for r in message_rows(s))) if s["messages"] else len(c)
+              for i, c in enumerate(COLUMNS)]
+    table = [" | ".join(c.ljust(w) for c, w in zip(COLUMNS, widths, strict=True))]
+    table += [" | ".join(c.ljust(w) for c, w in zip(r, widths, strict=True))
+              for r in message_rows(s)]
+    return "\n".join([vehicle_text(s), *table, thruster_text(s), "events:", *s["events"]])
+
+
+def make_app(reader: BusReader, title: str, refresh_s: float,
+             duration_s: float | None) -> Any:
+    """The textual application over ``reader`` (imported here: only the monitor needs it)."""
+    from textual.app import App, ComposeResult
+    from textual.widgets import DataTable, Footer, Header, Log, Static
+
+    class MonitorApp(App[None]):
+        CSS = "#vehicle {height: 5;} #thrusters {height: 6;} #events {height: 8;}"
+        BINDINGS: ClassVar = [("q", "quit", "Quit")]
+        TITLE = title
+
+        def compose(self) -> ComposeResult:
+            yield Header()
+            yield Static(id="vehicle")
+            yield DataTable(id="messages")
+            yield Static(id="thrusters")
+            yield Log(id="events")
+            yield Footer()
+
+        def on_mount(self) -> None:
+            self.query_one("#messages", DataTable).add_columns(*COLUMNS)
+            self.logged = 0
+            self.set_interval(refresh_s, self.redraw)
+            if duration_s is not None:
+                self.set_timer(duration_s, self.exit)
+
+        def redraw(self) -> None:
+            s = reader.snapshot()
+            self.picture = s
+            self.query_one("#vehicle", Static).update(vehicle_text(s))
+            self.query_one("#thrusters", Static).update(thruster_text(s))
+            table = self.query_one("#messages", DataTable)
+            table.clear()
+            table.add_rows(message_rows(s))
+            log = self.query_one("#events", Log)
+            for line in s["events"][self.logged:]:
+                log.write_line(line)
+            self.logged = len(s["events"])
+
+    return MonitorApp()
+
+
+def add_parser(sub: Any) -> None:
+    """The ``monitor`` subcommand of ``thruster-hil``."""
+    from dbc import options as opt
+
+    mp = sub.add_parser("monitor", help="watch a bus live, every frame decoded with the DBC "
+                        "and checked (a run's channel, SocketCAN, real hardware)")
+    mp.add_argument("--bus", type=opt.text("--bus", "a bus spec"), required=True,
+                    help="bus spec, e.g. hilbus:run-1a2b3c4d (printed by `run`) or "
+                    "socketcan:vcan0")
+    mp.add_argument("--duration", type=opt.number("--duration", 0.1, 1e6, unit="s"),
+                    help="stop after this many seconds (default: until q)")
+    mp.add_argument("--refresh", type=opt.number("--refresh", 0.05, 10.0, unit="s"),
+                    default=DEFAULT_REFRESH_S, help="seconds between redraws (default 0.25)")
+
+
+def run(args: Any, db: Database | None = None) -> int:
+    """``thruster-hil monitor``: open the bus, read it, show it (module docstring)."""
+    import sys
+
+    from dbc.database import load_database
+    from transport.spec import check_bus_spec, open_bus
+
+    check_bus_spec(args.bus)
+    if not sys.stdout.isatty() and args.duration is None:
+        raise ConfigError("command line", "--duration", None, "a duration when the output "
+                          "is not a terminal (the monitor then prints its last picture)")
+    db = db or load_database()
+    bus = open_bus(args.bus)
+    reader = BusReader(bus, MonitorState(db))
+    reader.start()
+    print(f"thruster-hil monitor: listening on {args.bus}", file=sys.stderr, flush=True)
+    try:
+        app = make_app(reader, f"thruster-hil monitor {args.bus}", args.refresh,
+                       args.duration)
+        app.run(headless=not sys.stdout.isatty())
+        if not sys.stdout.isatty():
+            print(text_picture(reader.snapshot()))
+    finally:
+        reader.stop()
+        bus.shutdown()
+    return 0
