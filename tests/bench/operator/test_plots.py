@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from bench.operator.plots import MAX_PLOT_POINTS, _read_columns, envelope, plot_run
-from bench.results.telemetry import telemetry_columns
+from tests.bench.operator.run_telemetry import write_telemetry
 
 N_THRUSTERS = 4
 
@@ -50,14 +50,7 @@ def test_columns_are_read_line_by_line_skipping_a_cut_line(tmp_path: Path) -> No
 
 def test_plots_are_drawn_from_a_run_folder(tmp_path: Path) -> None:
     """A telemetry.csv and valve_pulses.csv of a long run give the three PNGs."""
-    cols = telemetry_columns(N_THRUSTERS)
-    n = 3 * MAX_PLOT_POINTS
-    data = np.zeros((n, len(cols)))
-    data[:, 0] = np.arange(n) * 0.01
-    data[:, cols.index("att_err_deg")] = np.exp(-data[:, 0])
-    with open(tmp_path / "telemetry.csv", "w", encoding="utf-8") as f:
-        f.write(",".join(cols) + "\n")
-        f.writelines(",".join(map(repr, row.tolist())) + "\n" for row in data)
+    write_telemetry(tmp_path, N_THRUSTERS, 3 * MAX_PLOT_POINTS)
     (tmp_path / "valve_pulses.csv").write_text("thruster,t_on_s,t_off_s\n1,0.5,0.6\n3,2.0,2.1\n")
     paths = plot_run(tmp_path, 0.1)
     assert [p.name for p in paths] == ["attitude_error.png", "rates.png", "thruster_raster.png"]

@@ -8,11 +8,9 @@ import re
 from html.parser import HTMLParser
 from pathlib import Path
 
-import numpy as np
-
 from bench.operator.plots import AXES_SUFFIX, MAX_PLOT_POINTS, plot_run
 from bench.operator.report_html import FIGURES, event_marks, read_events, write_report
-from bench.results.telemetry import telemetry_columns
+from tests.bench.operator.run_telemetry import write_telemetry
 
 EVENTS = [
     {"event": "run_started", "mode": "lockstep", "t_s": 0.0},
@@ -41,14 +39,7 @@ class _Page(HTMLParser):
 
 
 def _run_folder(tmp_path: Path) -> Path:
-    cols = telemetry_columns(2)
-    n = 2 * MAX_PLOT_POINTS
-    data = np.zeros((n, len(cols)))
-    data[:, 0] = np.arange(n) * 0.01
-    data[:, cols.index("att_err_deg")] = np.exp(-data[:, 0])
-    with open(tmp_path / "telemetry.csv", "w", encoding="utf-8") as f:
-        f.write(",".join(cols) + "\n")
-        f.writelines(",".join(map(repr, row.tolist())) + "\n" for row in data)
+    write_telemetry(tmp_path, 2, 2 * MAX_PLOT_POINTS)
     (tmp_path / "valve_pulses.csv").write_text("thruster,t_on_s,t_off_s\n1,0.5,0.6\n")
     (tmp_path / "events.jsonl").write_text("".join(json.dumps(e) + "\n" for e in EVENTS))
     (tmp_path / "summary.json").write_text(json.dumps({
