@@ -65,6 +65,12 @@ class Clock:
         """Nanoseconds since the clock was made."""
         return time.monotonic_ns() - self.t0_ns
 
+    def restart(self) -> None:
+        """Make this instant the clock's zero (a realtime run starts when the flight
+        software is heard, not when the bench was built)."""
+        self.t0_ns = time.monotonic_ns()
+        self.wall0_s = time.time()
+
     def from_wall_ns(self, wall_s: float) -> int:
         """A wall-clock timestamp (``time.time()`` seconds, e.g. a frame's) on this clock."""
         return round((wall_s - self.wall0_s) * NS_PER_S)

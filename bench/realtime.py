@@ -46,6 +46,9 @@ class Realtime:
         """Wall-clock-paced run of ``duration_s`` seconds (module docstring)."""
         n = self.node
         n.wait_for_fsw()
+        # t = 0 is now: the flight software's start-up (0.3 s and more) is no lag of the
+        # plant's (it counted as a late step, and the valve watchdog tripped, every run)
+        self.clock.restart()
         n.started = True
         n.trace.event(0, "run_started", mode=n.mode, seed=n.seed)
         clock = self.clock
