@@ -8,8 +8,9 @@ instead of polling first: see transport.lockstep). The flight software's FDIR re
 (FSW_FDIR, in each summary.json) gives detection and isolation. Out, in DIR:
 ``campaign.csv`` (one row per run: thruster, kind, detected, detection time after the
 fault, isolated thruster, isolation correct, expectations met, final attitude and position
-error, propellant), ``campaign.json`` and ``campaign.png`` (detection time per thruster and
-kind), plus every run folder. Exit 0 if every run detected and isolated its failure and met
+error, propellant), ``campaign.json``, ``campaign.png`` (detection time per thruster and
+kind) and ``campaign.html`` (the figure and the table, each case linked to its run's
+report.html), plus every run folder. Exit 0 if every run detected and isolated its failure and met
 the scenario's expectations, 1 if not, 2 on bad input, 3 if a run could not complete.
 """
 
@@ -27,6 +28,7 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
+from bench.operator.report_html import campaign_html
 from bench.scenario.load import load_scenario
 from dbc import options as opt
 from dbc.errors import ConfigError, RunError
@@ -135,6 +137,9 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
         w.writerows(rows)
     write_record(out / "campaign.json", {"cases": rows})
     _plot(rows, out / "campaign.png")
+    (out / "campaign.html").write_text(
+        campaign_html(rows, COLUMNS, (out / "campaign.png").read_bytes(), out),
+        encoding="utf-8")
     return rows
 
 

@@ -13,7 +13,9 @@ position and propellant figures; frame counts and rejects per message; latency a
 lockstep cycle split; the faults and FDIR. A run drawn with ``--no-plots`` gets the
 report without its figures.
 
-Everything from the files is escaped (html.escape); styles are inline. Opens from a mail
+:func:`campaign_html` is a campaign's page: its figure and one row per case, linking each
+case's report.html by a relative path. Everything from the files is escaped
+(html.escape); styles are inline. Opens from a mail
 attachment: nothing is fetched.
 """
 
@@ -187,3 +189,26 @@ def write_report(run_dir: Path) -> Path | None:
     out = run_dir / "report.html"
     out.write_text(report_html(s, events, figures, run_dir), encoding="utf-8")
     return out
+
+
+def campaign_html(rows: list[dict[str, Any]], columns: list[str], png: bytes | None,
+                  out: Path) -> str:
+    """A campaign's page: its figure inline and one row per case, each linking the case's
+    report.html by a path relative to the campaign folder ``out`` (the folder can move)."""
+    cells = []
+    for r in rows:
+        run_dir = Path(str(r["run_dir"]))
+        try:
+            href = (run_dir / "report.html").relative_to(out).as_posix()
+        except ValueError:
+            href = (run_dir / "report.html").as_posix()
+        link = Raw(f"<a href='{html.escape(href, quote=True)}'>report</a>")
+        cells.append([r.get(c) for c in columns if c != "run_dir"] + [link])
+    figure = ("" if png is None else "<img alt='campaign' style='width:100%' src='data:image/"
+              f"png;base64,{base64.b64encode(png).decode('ascii')}'>")
+    failed = sum(1 for r in rows if not r.get("expectations_met"))
+    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>campaign</title>"
+            f"<style>{STYLE}</style></head><body><h1>Campaign: {len(rows)} cases, "
+            f"{failed} not meeting their expectations</h1>{figure}"
+            + _table([c for c in columns if c != "run_dir"] + ["case"], cells)
+            + "</body></html>\n")

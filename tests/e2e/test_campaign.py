@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -54,6 +55,9 @@ def test_every_single_thruster_failure_is_detected_isolated_and_survived(tmp_pat
         assert r["isolation_correct"] == "True", case
         assert r["expectations_met"] == "True", case
     assert (out / "campaign.png").stat().st_size > 0
+    # campaign.html links each case's report.html, relative to the campaign folder
+    links = re.findall(r"href='([^']+)'", (out / "campaign.html").read_text(encoding="utf-8"))
+    assert len(links) == len(rows) and all((out / h).is_file() for h in links)
     assert p.returncode == 0, p.stdout[-2000:]
     # redirected (not a terminal): one line per run as it finished, numbered, then the verdict
     progress = [ln for ln in p.stdout.splitlines() if ln.startswith("[")]

@@ -87,3 +87,16 @@ def test_without_figures_the_report_says_so(tmp_path: Path) -> None:
     text = write_report(run).read_text(encoding="utf-8")  # type: ignore[union-attr]
     assert "no figures" in text and "thruster-hil report RUN_DIR" in text
     assert "fault_injected" in text
+
+
+def test_campaign_page_links_each_case_relative_to_its_folder(tmp_path: Path) -> None:
+    """One row and one relative link per case; text escaped; the figure inline."""
+    from bench.operator.report_html import campaign_html
+
+    rows = [{"thruster": k, "kind": "stuck_open", "expectations_met": k != 1,
+             "run_dir": str(tmp_path / f"stuck_open_T{k:02d}" / "run")} for k in range(3)]
+    page = campaign_html(rows, ["thruster", "kind", "expectations_met", "run_dir"], b"png",
+                         tmp_path)
+    assert re.findall(r"href='([^']+)'", page) == [
+        f"stuck_open_T{k:02d}/run/report.html" for k in range(3)]
+    assert "3 cases, 1 not meeting" in page and "data:image/png;base64," in page
