@@ -130,7 +130,7 @@ class MonitorState:
                              "jitter_ms": jitter, "last": self.last.get(m.name, {}),
                              "rejected": rejects})
         other = {k: dict(v.rejected) for k, v in self.checker.stats.items()
-                 if k not in {m.name for m in self.db.messages}}
+                 if k not in self.icd.sender}  # not a message of the DBC
         return {"frames": self.frames, "messages": messages, "other_rejects": other,
                 "vehicle": self._vehicle(), "thrusters": self._thrusters(),
                 "bus_load": sum(b for _, b in self.bits) / self.bitrate_bps,

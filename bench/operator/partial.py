@@ -10,12 +10,12 @@ of what was recorded, the frame counts and the faults seen.
 from __future__ import annotations
 
 import contextlib
-import json
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from bench.operator.fsw_process import fsw_report, wait_for_exit
+from bench.operator.report_html import read_events
 from bench.operator.verdict import abnormal, verdict
 from bench.results.counts import frame_table, merge_counts, zero_unheard
 from bench.results.error_stats import ErrorStats
@@ -80,16 +80,7 @@ def partial_summary(
             r["received"] += 1
     other: dict[str, dict[str, int]] = {}
     merge_counts(frames, other, "BENCH", sent, received)
-    faults = []
-    events = out / "events.jsonl"
-    if events.exists():
-        for line in events.read_text(encoding="utf-8").splitlines():
-            try:
-                ev = json.loads(line)
-            except json.JSONDecodeError:
-                continue  # a line cut by the kill
-            if ev.get("event") == "fault_injected":
-                faults.append(ev)
+    faults = [ev for ev in read_events(out) if ev.get("event") == "fault_injected"]
     summary: dict[str, Any] = {
         "scenario": sc.name, "scenario_file": sc.path, "mode": opts.mode, "seed": opts.seed,
         "record": opts.record, "files_sealed": sealed, "bus": opts.bus,

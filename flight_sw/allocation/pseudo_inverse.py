@@ -217,7 +217,9 @@ class PseudoInverseAllocator(ControlAllocation):
         # inequalities mapped to demand space, ``normals·U_rᵀ d ≤ h + tol``.
         self._neg_inv_v = None if self._null_v is None else -1.0 / self._null_v
         self._overflow_N = u_a * (1.0 + THRUST_RTOL)
-        self._normal: list[list[float]] | None = None  # BᵀB of the bounded least squares
+        # BᵀB of the bounded least squares (array and lists, as the QP allocators keep M)
+        self._m_mat = b_a.T @ b_a
+        self._m_list = self._m_mat.tolist()
         self._free = np.full(u_a.size, FREE, dtype=np.int8)
         self._halfspaces: tuple[np.ndarray, np.ndarray] | None = None
         if self._null_v is not None and params.exact_repair and rank:
@@ -251,10 +253,8 @@ class PseudoInverseAllocator(ControlAllocation):
 
     def _bounded_lsq(self, d: np.ndarray) -> np.ndarray:
         """``argmin ‖B T − d‖²`` over ``0 ≤ T ≤ T_max`` (least-norm where not unique)."""
-        if self._normal is None:
-            self._normal = (self._b_a.T @ self._b_a).tolist()
-        x, _ = box_qp(np.zeros(0), self._b_a.T @ d, np.zeros(self._hi_a.size), self._hi_a,
-                      self._free, False, self._normal)
+        x, _ = box_qp(self._m_mat, self._b_a.T @ d, self._lo_a, self._hi_a, self._free,
+                      False, self._m_list)
         return x
 
     def _in_range_residual(self, d: np.ndarray, t_a: np.ndarray) -> float:

@@ -188,9 +188,10 @@ ROWS: list[Row] = [
     _r(HIL, "export missing --format xls", "thruster-hil: error: command line: --format = "
        "'xls': expected one of csv, mf4"),
     # thruster-hil monitor
-    _r(HIL, "monitor --bus hilbus:x", "thruster-hil: error: command line: --duration = None: "
-       "expected a duration when the output is not a terminal (the monitor then prints its "
-       "last picture)", shown="monitor --bus hilbus:x  # output not a terminal"),
+    _r(HIL, "monitor --bus hilbus:bad-input-monitor", "thruster-hil: error: command line: "
+       "--duration = None: expected a duration when the output is not a terminal (the "
+       "monitor then prints its last picture)",
+       shown="monitor --bus hilbus:bad-input-monitor  # output not a terminal"),
     _r(HIL, "monitor --bus hilbus --duration 1", "thruster-hil: error: command line: --bus = "
        "'hilbus': expected INTERFACE:CHANNEL[?key=value&...], e.g. socketcan:vcan0 or "
        "hilbus:default"),
