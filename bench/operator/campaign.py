@@ -28,6 +28,8 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
+from bench.campaign.cli import run_campaign_file
+from bench.campaign.spec import is_campaign_file
 from bench.operator.report_html import campaign_html
 from bench.scenario.load import load_scenario
 from dbc import options as opt
@@ -174,17 +176,22 @@ def add_arguments(p: argparse.ArgumentParser, default_jobs: int) -> None:
     """The campaign's options (shared with ``thruster-hil campaign``), each checked as it is
     parsed (:mod:`dbc.options`); the fault time against the scenario's duration later."""
     p.add_argument("scenario", type=opt.text("SCENARIO", "a scenario file"),
-                   help="scenario TOML file (its thrusters, duration, seed)")
+                   help="a campaign file (with a [campaign] table: dispersions, Monte Carlo, "
+                   "sweeps; docs/campaigns.md) or a scenario TOML file (every single "
+                   "stuck_closed / stuck_open failure of its thrusters)")
     p.add_argument("--out", required=True, type=opt.text("--out", "a folder path"),
                    help="folder for campaign.csv/.json/.png and runs")
     p.add_argument("--fault-time", type=opt.number("--fault-time", 0.0, unit="s"),
-                   default=DEFAULT_FAULT_TIME_S,
                    help="when each fault starts [s], before the scenario's end "
                    f"(default {DEFAULT_FAULT_TIME_S:g})")
-    p.add_argument("--jobs", type=opt.integer("--jobs", 1, MAX_JOBS), default=default_jobs,
-                   help=f"runs at a time, 1..{MAX_JOBS} (default {default_jobs})")
-    p.add_argument("--kinds", nargs="+", type=opt.choice("--kinds", KINDS),
-                   default=list(KINDS), metavar="KIND",
+    p.add_argument("--jobs", type=opt.integer("--jobs", 1, MAX_JOBS),
+                   help=f"runs at a time, 1..{MAX_JOBS} (default {default_jobs}; a campaign "
+                   "file: Dask workers, default one per CPU)")
+    p.add_argument("--scheduler", type=opt.text("--scheduler", "tcp://HOST:PORT"),
+                   help="a campaign file's cases on this running Dask scheduler (its workers "
+                   "have the project installed and see --out at the same path); default: a "
+                   "local Dask cluster sized to the machine")
+    p.add_argument("--kinds", nargs="+", type=opt.choice("--kinds", KINDS), metavar="KIND",
                    help=f"failure kinds: {' '.join(KINDS)} (default both)")
 
 
@@ -223,8 +230,20 @@ def main(argv: list[str] | None = None) -> int:
     if isinstance(args, int):
         return args
     try:
-        rows = run_campaign(Path(args.scenario), Path(args.out), args.fault_time, args.jobs,
-                            tuple(args.kinds), _progress_printer())
+        if is_campaign_file(args.scenario):
+            for option, given in (("--fault-time", args.fault_time), ("--kinds", args.kinds)):
+                if given is not None:
+                    opt.refuse(option, given, "absent with a campaign file (its [campaign] "
+                               "table says fault_time_s and failures)")
+            return run_campaign_file(Path(args.scenario), Path(args.out), args.jobs,
+                                     args.scheduler)
+        if args.scheduler is not None:
+            opt.refuse("--scheduler", args.scheduler, "absent with a scenario file (the "
+                       "single-failure sweep runs locally; a campaign file runs on Dask)")
+        rows = run_campaign(Path(args.scenario), Path(args.out),
+                            DEFAULT_FAULT_TIME_S if args.fault_time is None else args.fault_time,
+                            args.jobs or max(1, (os.cpu_count() or 2) // 2),
+                            tuple(args.kinds or KINDS), _progress_printer())
     except ConfigError as exc:
         print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -313,8 +313,9 @@ def build_parser() -> argparse.ArgumentParser:
     inj.add_argument("--clear", action="store_true", help="clear the fault instead")
     inj.add_argument("--print-frame", type=opt.integer("--print-frame"), metavar="COUNTER",
                      help="only print the frame for cansend, with this alive counter")
-    cp = sub.add_parser("campaign", help="every single-thruster stuck_closed / stuck_open "
-                        "failure of a scenario, one lockstep run each; CSV + PNG")
+    cp = sub.add_parser("campaign", help="a campaign file's Monte Carlo / sweep on Dask, or "
+                        "every single-thruster failure of a scenario; `campaign rerun DIR "
+                        "CASE` reruns one case, `campaign margin` finds a requirement's margin")
     from bench.operator.campaign import add_arguments
 
     add_arguments(cp, default_jobs=1)
@@ -355,8 +356,14 @@ def _cmd_inject(args: argparse.Namespace) -> int:
 def _cmd_campaign(args: argparse.Namespace) -> int:
     from bench.operator.campaign import main as campaign_main
 
-    return campaign_main([args.scenario, "--out", args.out, "--fault-time", str(args.fault_time),
-                          "--jobs", str(args.jobs), "--kinds", *args.kinds])
+    argv = [args.scenario, "--out", args.out]
+    for option, value in (("--fault-time", args.fault_time), ("--jobs", args.jobs),
+                          ("--scheduler", args.scheduler)):
+        if value is not None:
+            argv += [option, str(value)]
+    if args.kinds is not None:
+        argv += ["--kinds", *args.kinds]
+    return campaign_main(argv)
 
 
 def _add_timing_parser(sub: Any) -> None:
@@ -433,6 +440,11 @@ def _add_timing_parser(sub: Any) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``thruster-hil`` console script."""
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:2] in (["campaign", "rerun"], ["campaign", "margin"]):
+        from bench.campaign.tools import main as campaign_tool
+
+        return campaign_tool(argv[1:])
     args = opt.parse_or_exit_code(build_parser(), argv)
     if isinstance(args, int):
         return args

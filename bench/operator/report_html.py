@@ -63,7 +63,7 @@ def _e(x: Any) -> str:
     return html.escape("n/a" if x is None else str(x))
 
 
-def _table(head: list[str], rows: list[list[Any]]) -> str:
+def html_table(head: list[str], rows: list[list[Any]]) -> str:
     out = ["<table><tr>" + "".join(f"<th>{_e(h)}</th>" for h in head) + "</tr>"]
     out += ["<tr>" + "".join(f"<td>{c if isinstance(c, Raw) else _e(c)}</td>" for c in r)
             + "</tr>" for r in rows]
@@ -101,7 +101,7 @@ def report_html(s: dict[str, Any], events: list[dict[str, Any]], figures: dict[s
         ["simulated [s]", s.get("sim_time_s")], ["wall [s]", s.get("wall_time_s")],
         ["real-time factor", s.get("realtime_factor")], ["run folder", str(run_dir)],
     ]
-    parts.append(_table(["run", ""], run_rows + _versions()))
+    parts.append(html_table(["run", ""], run_rows + _versions()))
     reqs = s.get("requirements") or {}
     rows: list[list[Any]] = [["converged", s.get("final_attitude_error_deg"),
                               s.get("settling_band_deg"), reqs.get("converged"),
@@ -109,31 +109,31 @@ def report_html(s: dict[str, Any], events: list[dict[str, Any]], figures: dict[s
     rows += [[e["name"], e.get("value"), e.get("max"), e.get("req"),
               Raw(_verdict_cell(bool(e.get("pass"))))] for e in s.get("expectations") or []]
     parts += ["<h2>Expectations</h2>",
-              _table(["check", "value", "bound", "requirement", ""], rows)]
+              html_table(["check", "value", "bound", "requirement", ""], rows)]
     parts += ["<h2>Figures</h2>"]
     parts += [f"<h3>{_e(title)}</h3>{figures[name]}" for name, title in FIGURES
               if name in figures] or ["<p>no figures (the run was drawn with --no-plots: "
                                       "thruster-hil report RUN_DIR draws them)</p>"]
-    parts += ["<h2>Events</h2><p>numbered as the figures mark them</p>", _table(
+    parts += ["<h2>Events</h2><p>numbered as the figures mark them</p>", html_table(
         ["#", "t [s]", "event", "details"],
         [[i, ev.get("t_s"), ev.get("event"),
           ", ".join(f"{k}={v}" for k, v in ev.items() if k not in ("event", "t_s"))]
          for i, ev in enumerate(events)])]
-    parts += ["<h2>Pointing, position, propellant</h2>", _table(["figure", "value"], [
+    parts += ["<h2>Pointing, position, propellant</h2>", html_table(["figure", "value"], [
         [k, s.get(k)] for k in ("settling_time_s", "steady_state_attitude_error_deg",
                                 "steady_state_rate_error_deg_s", "final_attitude_error_deg",
                                 "final_position_error_m", "steady_state_position_error_m",
                                 "propellant_kg", "net_translation", "valve_openings")])]
     frames = s.get("frames") or {}
-    parts += ["<h2>Frames</h2>", _table(["message", "counts"], [
+    parts += ["<h2>Frames</h2>", html_table(["message", "counts"], [
         [name, ", ".join(f"{k}={v}" for k, v in (row or {}).items())]
         for name, row in frames.items()])]
-    parts += ["<h2>Timing</h2>", _table(["measure", "value"], [
+    parts += ["<h2>Timing</h2>", html_table(["measure", "value"], [
         ["latency sensor->command [us]", (s.get("latency_us") or {}).get("sensor_to_command")],
         ["lockstep cycle wall [us]", s.get("lockstep_wall_us")],
         ["deadline misses", s.get("deadline_misses")],
         ["bus overrun drops", s.get("bus_overrun_drops")]])]
-    parts += ["<h2>Faults and FDIR</h2>", _table(["", "value"], [
+    parts += ["<h2>Faults and FDIR</h2>", html_table(["", "value"], [
         ["faults", s.get("faults")], ["fault effects", s.get("fault_effects")],
         ["fdir", s.get("fdir")], ["mode changes", s.get("fsw_mode_changes")]])]
     warnings = s.get("warnings") or []
@@ -210,5 +210,5 @@ def campaign_html(rows: list[dict[str, Any]], columns: list[str], png: bytes | N
     return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>campaign</title>"
             f"<style>{STYLE}</style></head><body><h1>Campaign: {len(rows)} cases, "
             f"{failed} not meeting their expectations</h1>{figure}"
-            + _table([c for c in columns if c != "run_dir"] + ["case"], cells)
+            + html_table([c for c in columns if c != "run_dir"] + ["case"], cells)
             + "</body></html>\n")

@@ -36,10 +36,20 @@ from bench.scenario.spec import (
     ValveSpec,
 )
 from bench.station.dynamics.hcw import SEED000_ORBIT_RADIUS_M
-from bench.station.dynamics.rigid_body import MassProperties
+from bench.station.dynamics.rigid_body import (
+    MassProperties,
+    quat_from_axis_angle,
+    quat_multiply,
+    quat_normalize,
+)
 from bench.station.environment.disturbance import FORCE_FRAMES, DisturbanceParams, Sinusoid
 from bench.station.faults import parse_faults
 from bench.station.reference import KIND_STEP, KINDS, ReferenceParams, reference
+from bench.station.valves.geometry import (
+    MAX_MISALIGNMENT_DEG,
+    ThrusterGeometry,
+    misaligned_geometry,
+)
 from bench.station.valves.layouts import LAYOUT_MAX_THRUST_N, LAYOUTS
 from dbc import validation as check
 from dbc.codec import bitrate_bps, bitrate_range_bps, cycle_time_ns
@@ -47,6 +57,13 @@ from dbc.database import load_database
 from dbc.errors import ConfigError
 from dbc.icd import Icd
 from dbc.schema import Table
+
+MAX_THRUST_SCALE = 2.0
+"""``[thrusters] actual_thrust_scale`` at most this: a thruster twice its rating is no
+longer a tolerance."""
+MAX_COM_OFFSET_M = 10.0
+"""``[vehicle] com_offset_B_m``: each component at most this [m] (the vehicles a bench hosts
+are metres across)."""
 
 DEG_RAD = math.pi / 180.0
 # A target Euler angle beyond a full turn is no attitude anyone writes: a unit slip.
@@ -74,6 +91,16 @@ def quat_from_euler_zyx(yaw_rad: float, pitch_rad: float, roll_rad: float) -> Qu
 def _quat(t: Table, key: str) -> Quat:
     a, b, c, d = t.unit_vector(key, QUAT_SIZE)
     return (a, b, c, d)
+
+
+def _turned(q_BN: Quat, rotation_deg: tuple[float, ...]) -> Quat:
+    """``q_BN`` followed by a body-axis rotation given as a rotation vector [deg]
+    (``[initial] attitude_offset_deg``: a dispersed initial attitude)."""
+    angle = math.radians(math.sqrt(sum(x * x for x in rotation_deg)))
+    if angle == 0.0:
+        return q_BN
+    axis = tuple(math.radians(x) / angle for x in rotation_deg)
+    return quat_normalize(quat_multiply(q_BN, quat_from_axis_angle(axis, angle)))  # type: ignore[arg-type]
 
 
 def _mass(t: Table) -> MassSpec:
@@ -126,6 +153,7 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
                           "absent with an explicit list (give max_thrust_N per entry)")
         maxima = t.vector("max_thrust_per_thruster_N", len(geo), lo=0.0, lo_open=True)
         geo = [dataclasses.replace(g, max_thrust_N=m) for g, m in zip(geo, maxima, strict=True)]
+    geo = _actual_thrusters(t, geo)
     v = ValveSpec(
         max_thrust_N=t.number("max_thrust_N", lo=0.0, lo_open=True),
         isp_s=t.number("isp_s", lo=0.0, lo_open=True),
@@ -138,6 +166,38 @@ def _thrusters(t: Table) -> tuple[tuple[ThrusterSpec, ...], ValveSpec]:
     )
     t.done()
     return tuple(geo), v
+
+
+def _actual_thrusters(t: Table, geo: list[ThrusterSpec]) -> list[ThrusterSpec]:
+    """The bench's truth where it differs from what the flight software is told (a
+    campaign's dispersions): ``actual_thrust_scale`` (one factor per thruster, in
+    (0, MAX_THRUST_SCALE]) and ``actual_misalignment_deg`` (one rotation vector per
+    thruster [deg]: the force direction turned by its norm about its direction)."""
+    n = len(geo)
+    if t.has("actual_thrust_scale"):
+        scales = t.vector("actual_thrust_scale", n, lo=0.0, lo_open=True, hi=MAX_THRUST_SCALE)
+        geo = [dataclasses.replace(g, thrust_scale=k) for g, k in zip(geo, scales, strict=True)]
+    if t.has("actual_misalignment_deg"):
+        rows = t.raw("actual_misalignment_deg")
+        if not isinstance(rows, list) or len(rows) != n:
+            raise t.error("actual_misalignment_deg", rows,
+                          f"{n} rotation vectors [deg], one per thruster")
+        key = t.dotted("actual_misalignment_deg")
+        out = []
+        for i, (g, row) in enumerate(zip(geo, rows, strict=True)):
+            rv = check.triple(t.source, f"{key}[{i}]", row, unit="deg")
+            angle = math.sqrt(rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2])
+            if angle > MAX_MISALIGNMENT_DEG:
+                raise ConfigError(t.source, f"{key}[{i}]", list(rv),
+                                  f"a rotation of at most {MAX_MISALIGNMENT_DEG:g} deg")
+            if angle > 0.0:
+                axis = (rv[0] / angle, rv[1] / angle, rv[2] / angle)
+                _, turned = misaligned_geometry(ThrusterGeometry(g.r_thr_B_m, g.d_thr_B),
+                                                {"angle_deg": angle, "axis_B": axis}, t.source)
+                g = dataclasses.replace(g, actual_d_thr_B=turned.d_thr_B)
+            out.append(g)
+        geo = out
+    return geo
 
 
 def _icd_range(db: Database, message: str, signals: tuple[str, ...]) -> float:
@@ -287,6 +347,9 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
 
     vt = root.table("vehicle")
     actual = _mass(vt)
+    if vt.has("com_offset_B_m"):
+        c = vt.vector("com_offset_B_m", VEC3_SIZE, lo=-MAX_COM_OFFSET_M, hi=MAX_COM_OFFSET_M)
+        actual = dataclasses.replace(actual, com_offset_B_m=(c[0], c[1], c[2]))
     nominal = _mass(vt.table("nominal")) if vt.has("nominal") else actual
     vt.done()
 
@@ -305,6 +368,9 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
 
     it = root.table("initial", {})
     q0 = _quat(it, "q_BN") if it.has("q_BN") else (1.0, 0.0, 0.0, 0.0)
+    if it.has("attitude_offset_deg"):
+        q0 = _turned(q0, it.vector("attitude_offset_deg", VEC3_SIZE,
+                                   lo=-MAX_MISALIGNMENT_DEG, hi=MAX_MISALIGNMENT_DEG))
     w0 = tuple(x * DEG_RAD for x in it.vector("omega_BN_B_deg_s", 3, [0.0, 0.0, 0.0]))
     r0 = it.vector3("r_N_m", [0.0, 0.0, 0.0])
     v0 = it.vector3("v_N_m_s", [0.0, 0.0, 0.0])

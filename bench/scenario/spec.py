@@ -39,6 +39,9 @@ Quat = tuple[float, float, float, float]
 class MassSpec:
     mass_kg: float
     inertia_B_kgm2: tuple[Vec3, Vec3, Vec3]
+    com_offset_B_m: Vec3 = (0.0, 0.0, 0.0)
+    """Where the centre of mass actually is relative to the thruster geometry's reference
+    point [m, body axes] (the bench's truth only; the flight software assumes the origin)."""
 
 
 @dataclass(frozen=True)
@@ -47,6 +50,12 @@ class ThrusterSpec:
     d_thr_B: Vec3
     max_thrust_N: float | None = None
     """This thruster's maximum thrust [N]; None = the valve's ``max_thrust_N``."""
+    thrust_scale: float = 1.0
+    """Actual over nominal thrust (the bench's truth only; the flight software is told the
+    nominal): ``[thrusters] actual_thrust_scale``."""
+    actual_d_thr_B: Vec3 | None = None
+    """Actual unit force direction (the bench's truth only), None = ``d_thr_B``:
+    ``[thrusters] actual_misalignment_deg``."""
 
 
 @dataclass(frozen=True)
@@ -197,6 +206,14 @@ class Scenario:
         """Maximum thrust of every thruster [N] (its own, else the valve's)."""
         v = self.valve.max_thrust_N
         return tuple(v if t.max_thrust_N is None else t.max_thrust_N for t in self.thrusters)
+
+    @property
+    def actual_max_thrusts_N(self) -> tuple[float, ...]:
+        """What each thruster actually delivers at full thrust [N]: its maximum thrust times
+        its ``thrust_scale`` (the bench's truth; :attr:`max_thrusts_N` is what the flight
+        software is told)."""
+        return tuple(m * t.thrust_scale if t.thrust_scale != 1.0 else m
+                     for t, m in zip(self.thrusters, self.max_thrusts_N, strict=True))
 
     @property
     def has_position_reference(self) -> bool:

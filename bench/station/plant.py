@@ -17,6 +17,10 @@ every RK4 stage; ``capture`` events (``bench.station.dynamics.capture``) change 
 properties at the first step boundary at or after their time; the throttled valve
 model (``bench.station.valves.throttled``) replaces the on-off valves. The accelerometer's
 specific force includes the disturbance force (a non-gravitational force).
+
+Truth the flight software is not told (a campaign's dispersions; absent = nominal): each
+thruster's ``thrust_scale`` and actual direction, and the centre-of-mass offset
+(``ThrusterSet.set_com_offset``; a capture event's centre of mass replaces it).
 """
 
 from __future__ import annotations
@@ -65,7 +69,7 @@ class Plant:
                 tail_tau_s=v.tail_tau_s,
                 min_on_s=v.min_on_s,
             )
-            for m in sc.max_thrusts_N
+            for m in sc.actual_max_thrusts_N
         ]
         factory = None
         if v.model == "throttled":
@@ -77,10 +81,13 @@ class Plant:
                 return ThrottledValve(p, period, rng)
 
         self.thrusters = ThrusterSet(
-            [ThrusterGeometry(t.r_thr_B_m, t.d_thr_B) for t in sc.thrusters],
+            [ThrusterGeometry(t.r_thr_B_m, t.d_thr_B if t.actual_d_thr_B is None
+                              else t.actual_d_thr_B) for t in sc.thrusters],
             params,
             valve_factory=factory,
         )
+        if sc.actual.com_offset_B_m != (0.0, 0.0, 0.0):
+            self.thrusters.set_com_offset(sc.actual.com_offset_B_m)
         self.translation: TranslationModel = (
             HcwTranslation(HcwParams(sc.dynamics.orbit_radius_m))
             if sc.dynamics.translation == "hcw" else InertialTranslation()

@@ -150,6 +150,33 @@ PLANS: dict[str, Plan] = {
         "skip", why="the benchmark behind docs/reproductions.md: 30 full-length runs (many "
         "minutes); each scenario runs above, and tests/e2e/test_reproductions.py runs the "
         "headline variants at full length"),
+    "thruster-hil campaign scenarios/campaigns/quickstart_monte_carlo.toml --out runs/mc": Plan(
+        "skip", why="200 cases (minutes): docs/campaigns.md's smoke campaign runs below, with the "
+        "same machinery"),
+    # docs/campaigns.md
+    "thruster-hil campaign scenarios/campaigns/quickstart_smoke.toml --out runs/smoke": Plan(
+        "run", "thruster-hil campaign scenarios/campaigns/quickstart_smoke.toml --out runs/smoke",
+        RUN_OR_FAIL),
+    "thruster-hil campaign rerun runs/smoke 0003": Plan(
+        "run", "thruster-hil campaign rerun runs/smoke 0003"),
+    "thruster-hil campaign margin scenarios/three_axis_tracking_cascade.toml --key latency "
+    "--toward 0.1 --out runs/margin": Plan(
+        "run", "thruster-hil campaign margin scenarios/three_axis_tracking_cascade.toml --key "
+        "latency --toward 0.1 --out runs/margin --set scenario.duration_s=12 --tolerance 0.03",
+        why="about 8 runs of 60 s: the same search on the scenario cut to 12 s, a coarser "
+        "bracket"),
+    "python -m dask scheduler --scheduler-file /shared/sched.json": Plan(
+        "skip", why="a cluster on shared storage: tests/benchmarks/test_campaign_scale_script.py "
+        "starts a scheduler and two workers with these commands and runs a campaign on them"),
+    "python -m dask worker --scheduler-file /shared/sched.json --nthreads 1": Plan(
+        "skip", why="as above"),
+    "thruster-hil campaign scenarios/campaigns/quickstart_monte_carlo.toml --scheduler "
+    "tcp://HOST:8786 --out /shared/runs/mc": Plan(
+        "skip", why="as above (a campaign on a scheduler, with its results compared to the "
+        "local ones)"),
+    "python benchmarks/campaign_scale.py": Plan(
+        "skip", why="the acceptance figures: a 200-case campaign and more (many minutes); "
+        "tests/benchmarks/test_campaign_scale_script.py runs a small version"),
     # docs/timing-tests.md
     "thruster-hil run scenarios/quickstart.toml --out runs/a --duration 10": Plan(
         "run", f"{HIL_Q} --out runs/a --duration 10 --bus {{private}}", (1,),

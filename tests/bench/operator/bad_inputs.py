@@ -270,6 +270,31 @@ ROWS: list[Row] = [
        "--kinds = 'leak': expected one of stuck_closed, stuck_open"),
     _r(HIL, f"campaign {QUICKSTART}", "thruster-hil: error: the following arguments are "
        "required: --out"),
+    # thruster-hil campaign with a campaign file, rerun, margin
+    _r(HIL, "campaign bad_alias.toml --out c",
+       "thruster-hil campaign: error: bad_alias.toml: dispersions[0].name = 'mas': expec"
+       "ted one of accel_bias, bitrate, close_delay, com_offset, fault_target, fault_tim"
+       "e, gyro_bias, gyro_noise, inertia_xx, inertia_yy, inertia_zz, initial_attitude, "
+       "initial_position, initial_rate, initial_velocity, isp, latency, mass, min_on_tim"
+       "e, misalignment, open_delay, star_tracker_noise, thrust_scale"),
+    _r(HIL, "campaign impossible.toml --out c",
+       "thruster-hil campaign: error: impossible.toml: case 0000: vehicle.inertia_B_kgm2"
+       " = [[159.5, 0.0, 0.0], [0.0, 72.19, 0.0], [0.0, 0.0, 72.19]]: expected principal"
+       " moments obeying the triangle inequality (a physical body) (the dispersion drew "
+       "an impossible case: narrow its distribution)"),
+    _r(HIL, "campaign impossible.toml --out c --kinds stuck_open",
+       "thruster-hil campaign: error: command line: --kinds = ['stuck_open']: expected a"
+       "bsent with a campaign file (its [campaign] table says fault_time_s and failures)"),
+    _r(HIL, "campaign rerun nowhere 0001",
+       "thruster-hil campaign: error: command line: CASE = '0001': expected a case of th"
+       "e campaign folder nowhere (cannot read nowhere/cases/0001/case.json and result.j"
+       "son: No such file or directory)"),
+    _r(HIL, f"campaign margin {QUICKSTART} --key vehicle.mas_kg --toward 1 --out m",
+       "thruster-hil campaign: error: command line: --key = 'vehicle.mas_kg': expected a"
+       " key the scenario has (vehicle.mas_kg: not in the scenario)"),
+    _r(HIL, f"campaign margin {QUICKSTART} --key latency --toward 0.001 --out m",
+       "thruster-hil campaign: error: command line: --toward = 0.001: expected a value o"
+       "ther than the nominal 0.001"),
     # the flight software's own entry point
     _r(FSW, "--config missing.json", "flight_sw: error: missing.json: <file> = 'missing.json': "
        "expected a readable configuration file (No such file or directory)"),
@@ -324,6 +349,10 @@ def make_files(folder: Path) -> None:
     for name, text in (("notjson", "not json"), ("empty", "{}")):
         (folder / name).mkdir()
         (folder / name / "summary.json").write_text(text)
+    head = '[campaign]\nscenario = "scenarios/quickstart.toml"\n[[dispersions]]\n'
+    (folder / "bad_alias.toml").write_text(head + 'name = "mas"\ndist = "sweep"\nvalues = [1]\n')
+    (folder / "impossible.toml").write_text(head + 'name = "inertia_xx"\ndist = "sweep"\n'
+                                            'values = [10.0]\napply = "scale"\n')
     from bench.scenario.load import load_scenario
 
     config = load_scenario(REPO / "scenarios" / "fdir_16thr.toml").fsw_config()

@@ -1,0 +1,240 @@
+"""``thruster-hil campaign CAMPAIGN.toml --out DIR``: a statistical campaign, end to end.
+
+Reads the campaign file (:mod:`bench.campaign.spec`), builds and checks every case
+(:mod:`bench.campaign.cases`: each case's scenario is validated here, so an impossible
+dispersed vehicle is refused before any process starts, naming the case), runs them on
+Dask (:mod:`bench.campaign.engine`), keeps full traces only for failing and worst cases,
+and writes the tables and the report (:mod:`bench.campaign.report`). The console shows
+progress (cases done, pass rate so far, ETA), then each requirement's pass rate with its
+95 % interval, the wall time, cases per minute and the CPU used.
+
+The folder: ``campaign.toml`` and ``scenario.toml`` (copies: the campaign reruns from its
+folder alone), ``manifest.json`` (what the cases are: running the same campaign into the
+same folder resumes it; another campaign there is refused), ``cases/NAME/`` per case.
+
+Exit: 0 every case passed; 1 some failed; 2 bad input; 3 a case could not complete.
+"""
+
+from __future__ import annotations
+
+import copy
+import gzip
+import hashlib
+import json
+import os
+import shutil
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from bench.campaign.case_run import RESULT_FILE, STATUS_OK, run_command
+from bench.campaign.cases import Case, build_cases
+from bench.campaign.engine import run_cases
+from bench.campaign.report import write_html, write_tables
+from bench.campaign.spec import CASE_TIMEOUT_BASE_S, CampaignSpec, load_campaign
+from bench.campaign.stats import statistics
+from bench.results.record import read_lines, run_file
+from bench.scenario.load import apply_overrides
+from bench.scenario.parse import parse_scenario
+from dbc.datafile import parse_toml, read_text
+from dbc.errors import ConfigError, RunError
+from dbc.records import write_record
+from transport.lockstep import available_cpus
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
+SCENARIO_COPY = "scenario.toml"
+CAMPAIGN_COPY = "campaign.toml"
+MANIFEST = "manifest.json"
+TELEMETRY_DECIMATION = 10
+"""A pruned case keeps every this-many-th telemetry row (100 Hz -> 10 Hz)."""
+PRUNED = ("trace.asc", "frames.csv", "chains.csv", "valve_pulses.csv")
+"""Per-case files removed from cases that neither failed nor are among the worst."""
+
+
+def case_dict(c: Case, spec: CampaignSpec) -> dict[str, Any]:
+    """A case as the engine and case.json carry it."""
+    d = {"index": c.index, "name": c.name, "vehicle": c.vehicle, "seed": c.seed,
+         "overrides": list(c.overrides), "values": [list(v) for v in c.values],
+         "failure": None if c.failure is None else list(c.failure),
+         "fault_time_s": spec.fault_time_s}
+    d["command"] = " ".join(["thruster-hil", *_quoted(run_command(
+        Path(SCENARIO_COPY), d, Path(f"runs/{c.name}")))])
+    return d
+
+
+def _quoted(args: list[str]) -> list[str]:
+    import shlex
+
+    return [shlex.quote(a) for a in args]
+
+
+def checked_cases(spec: CampaignSpec) -> tuple[str, list[dict[str, Any]], float]:
+    """The scenario's text, every case (each validated as its run will), the timeout."""
+    text = read_text(spec.scenario, "scenario file")
+    data = parse_toml(text, str(spec.scenario))
+    apply_overrides(data, list(spec.overrides), f"{spec.source}: campaign.set")
+    sc = parse_scenario(copy.deepcopy(data), str(spec.scenario))
+    if spec.failures and not spec.fault_time_s < sc.duration_s:
+        raise ConfigError(spec.source, "campaign.fault_time_s", spec.fault_time_s,
+                          f"a time before the scenario's end ({sc.duration_s:g} s)")
+    cases = build_cases(spec, data, len(sc.thrusters), sc.seed)
+    raw = parse_toml(text, str(spec.scenario))
+    for c in cases:
+        d = copy.deepcopy(raw)
+        src = f"{spec.source}: case {c.name}"
+        apply_overrides(d, list(c.overrides), src)
+        try:
+            parse_scenario(d, src)
+        except ConfigError as exc:
+            raise ConfigError(src, exc.key, exc.value,
+                              f"{exc.expected} (the dispersion drew an impossible case: "
+                              "narrow its distribution)") from exc
+    timeout = spec.case_timeout_s or CASE_TIMEOUT_BASE_S + sc.duration_s
+    return text, [case_dict(c, spec) for c in cases], timeout
+
+
+def _prepare(out: Path, spec: CampaignSpec, text: str, cases: list[dict[str, Any]]) -> None:
+    digest = hashlib.sha256(json.dumps([text, cases], sort_keys=True).encode()).hexdigest()
+    man = out / MANIFEST
+    if man.exists():
+        old = json.loads(man.read_text(encoding="utf-8")).get("digest")
+        if old != digest:
+            raise ConfigError("command line", "--out", str(out), "an empty folder or this "
+                              "campaign's own (it holds another campaign's cases)")
+    elif out.exists() and any(out.iterdir()):
+        raise ConfigError("command line", "--out", str(out), "a new or empty folder")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / SCENARIO_COPY).write_text(text, encoding="utf-8")
+    shutil.copyfile(spec.source, out / CAMPAIGN_COPY)
+    write_record(man, {"digest": digest, "cases": len(cases)})
+
+
+def _decimate(run_dir: Path) -> None:
+    path = run_file(run_dir, "telemetry.csv")
+    if not path.exists():
+        return
+    lines = list(read_lines(path))
+    kept = lines[:1] + lines[1::TELEMETRY_DECIMATION]
+    tmp = path.with_name(path.name + ".tmp")
+    opener = gzip.open if path.suffix == ".gz" else open
+    with opener(tmp, "wt", encoding="utf-8") as f:
+        f.writelines(kept)
+    tmp.replace(path)
+
+
+def prune(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any], keep: str) -> int:
+    """Drop full traces of passing cases that are not among the worst; decimate their
+    telemetry. The number of cases pruned."""
+    if keep == "all":
+        return 0
+    worst = {w["name"] for ws in stats["worst"].values() for w in ws}
+    n = 0
+    for r in rows:
+        run_dir = out / "cases" / r["name"] / "run"
+        if r["status"] != STATUS_OK or not r["passed"] or r["name"] in worst:
+            continue
+        if not (out / "cases" / r["name"] / RESULT_FILE).exists():
+            continue
+        for base in PRUNED:
+            p = run_file(run_dir, base)
+            if p.exists():
+                p.unlink()
+        _decimate(run_dir)
+        n += 1
+    return n
+
+
+def _progress() -> Any:
+    tty = sys.stderr.isatty()
+    t0 = time.monotonic()
+    passed = [0]
+
+    def show(done: int, total: int, row: dict[str, Any]) -> None:
+        passed[0] += bool(row["passed"])
+        dt = time.monotonic() - t0
+        eta = dt / done * (total - done) if done else 0.0
+        outcome = ("error" if row["status"] != STATUS_OK else
+                   "pass" if row["passed"] else "FAIL")
+        line = (f"[{done}/{total}] pass {passed[0]}/{done}, ETA {eta:.0f} s; last "
+                f"{row['name']}: {outcome}")
+        if tty:
+            sys.stderr.write("\r" + line[:120].ljust(120))
+            if done == total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+        else:
+            print(line, flush=True)
+
+    return show
+
+
+def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str | None,
+                      ) -> int:
+    """Run the campaign file at ``path`` into ``out`` (module docstring); the exit code."""
+    spec = load_campaign(path)
+    text, cases, timeout = checked_cases(spec)
+    _prepare(out, spec, text, cases)
+    where = scheduler or f"a local Dask cluster of {workers or available_cpus()} workers"
+    print(f"campaign {spec.name}: {len(cases)} cases of {spec.scenario.name} on {where}; "
+          f"folder {out}", flush=True)
+    cpu0, t0 = os.times(), time.monotonic()
+    rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, workers, _progress())
+    wall = time.monotonic() - t0
+    cpu1 = os.times()
+    cpu_s = ((cpu1.children_user - cpu0.children_user)
+             + (cpu1.children_system - cpu0.children_system))
+    stats = statistics(rows, spec.worst)
+    meta: dict[str, Any] = {"name": spec.name, "scenario": spec.scenario.name, "study": spec.study,
+            "seed": spec.seed, "cases": len(cases), "wall_time_s": wall,
+            "cases_per_min": 60.0 * len(cases) / wall if wall > 0 else None,
+            "workers": None if scheduler else (workers or available_cpus()),
+            "scheduler": scheduler, "cpu_s": cpu_s if scheduler is None else None,
+            "cpu_use": cpu_s / (wall * available_cpus()) if scheduler is None and wall else None}
+    stats["pruned"] = prune(out, rows, stats, spec.keep)
+    write_tables(out, rows, stats, meta)
+    page = write_html(out, rows, stats, meta)
+    for name, r in stats["pass_rates"].items():
+        rate = "n/a" if r["rate"] is None else f"{r['rate']:.3f}"
+        print(f"  {name}: {r['passes']}/{r['cases']} = {rate}, 95 % interval "
+              f"[{r['ci_low']:.3f}, {r['ci_high']:.3f}]")
+    for r in rows:
+        if r["status"] != STATUS_OK:
+            print(f"  ERROR {r['name']}: {r['error']}")
+    use = "" if meta["cpu_use"] is None else f", CPU use {100 * meta['cpu_use']:.0f} %"
+    print(f"campaign: {len(rows)} cases in {wall:.1f} s ({meta['cases_per_min']:.1f} per "
+          f"minute{use}); {stats['errors']} errors; {page}")
+    if stats["errors"]:
+        return EXIT_RUN_ERROR
+    return EXIT_OK if stats["pass_rates"]["passed"]["passes"] == len(rows) else EXIT_FAILED
+
+
+def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
+    """``thruster-hil campaign rerun DIR CASE``: run the case again from its case.json; exit
+    0 if its trace records equal the campaign's (``trace_sha256``), 1 if not."""
+    from bench.campaign.case_run import CASE_FILE, trace_digest
+
+    case_dir = campaign_dir / "cases" / name
+    try:
+        case = json.loads((case_dir / CASE_FILE).read_text(encoding="utf-8"))
+        row = json.loads((case_dir / RESULT_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ConfigError("command line", "CASE", name, f"a case of the campaign folder "
+                          f"{campaign_dir} (cannot read {case_dir}/{CASE_FILE} and "
+                          f"{RESULT_FILE}: {getattr(exc, 'strerror', None) or exc})") from exc
+    run_dir = out or campaign_dir / "reruns" / name
+    if run_dir.exists():
+        shutil.rmtree(run_dir)
+    import subprocess
+
+    cmd = [sys.executable, "-m", "bench.operator.cli",
+           *run_command(campaign_dir / SCENARIO_COPY, case, run_dir)]
+    print("rerun: " + case["command"], flush=True)
+    p = subprocess.run(cmd, check=False)
+    if not (run_dir / "summary.json").exists():
+        raise RunError(f"rerun of {name} did not complete (exit {p.returncode})")
+    got = trace_digest(run_dir)
+    same = got == row["trace_sha256"]
+    print(f"rerun {name}: trace records {'identical to' if same else 'DIFFERENT from'} the "
+          f"campaign's (sha256 {got}); {run_dir}")
+    return EXIT_OK if same else EXIT_FAILED

@@ -1,0 +1,130 @@
+"""Run a campaign's cases on Dask: a local cluster sized to the machine, or a scheduler.
+
+One Dask task is one case (:func:`bench.campaign.case_run.run_case`: one ``thruster-hil
+run`` process, its bench + flight-software pair on a channel of its own). With no
+scheduler, a ``distributed.LocalCluster`` of one single-threaded worker process per CPU
+(``available_cpus``) is started and closed with the campaign; ``scheduler`` =
+``tcp://HOST:PORT`` sends the cases to a cluster started with Dask's own commands
+(``dask scheduler``, ``dask worker``), whose workers have the project installed and see
+``out`` at the same path.
+
+- A case that raises (a crash, a timeout) is retried once (Dask ``retries=1``); a case
+  whose worker dies is rescheduled by Dask; after that it is recorded as an error row,
+  never dropped. A refused input (exit 2) is not retried.
+- Resume: a case whose ``cases/NAME/result.json`` exists with the same case is not run
+  again; stale attempt folders (a lost worker's, an interrupted campaign's) are removed
+  before and after.
+- Results do not depend on the executor, the number of workers or the order cases finish
+  in: each row comes from its own case alone, and rows are returned in case order.
+
+``progress(done, total, row)`` is called as each case ends (and for each resumed case).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import shutil
+import uuid
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from bench.campaign.case_run import (
+    ATTEMPT_MARK,
+    CASE_FILE,
+    RESULT_FILE,
+    STATUS_OK,
+    STATUS_REFUSED,
+    CaseRefusedError,
+    error_row,
+    run_case,
+)
+from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
+
+PROCESSES_PER_CASE = 2  # bench + flight software
+RETRIES = 1
+DASK_LOG_LEVEL = logging.ERROR  # Dask's own INFO lines would bury the progress
+Progress = Callable[[int, int, dict[str, Any]], None]
+
+
+def _done_rows(cases_dir: Path, cases: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
+    """Rows of cases already complete in ``cases_dir`` (same case), by index."""
+    out = {}
+    for c in cases:
+        d = cases_dir / c["name"]
+        try:
+            same = json.loads((d / CASE_FILE).read_text(encoding="utf-8")) == c
+            row = json.loads((d / RESULT_FILE).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if same and row.get("status") == STATUS_OK:
+            out[c["index"]] = row
+    return out
+
+
+def _clear_attempts(cases_dir: Path) -> None:
+    if cases_dir.exists():
+        for d in cases_dir.iterdir():
+            if ATTEMPT_MARK in d.name:
+                shutil.rmtree(d, ignore_errors=True)
+
+
+def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s: float,
+              scheduler: str | None = None, workers: int | None = None,
+              progress: Progress | None = None) -> list[dict[str, Any]]:
+    """Every case's row, in case order (module docstring)."""
+    from distributed import Client, LocalCluster, as_completed
+
+    cases_dir = out / "cases"
+    cases_dir.mkdir(parents=True, exist_ok=True)
+    _clear_attempts(cases_dir)
+    rows = _done_rows(cases_dir, cases)
+    total = len(cases)
+    for n, i in enumerate(sorted(rows), start=1):
+        if progress is not None:
+            progress(n, total, rows[i])
+    todo = [c for c in cases if c["index"] not in rows]
+    if not todo:
+        return [rows[c["index"]] for c in cases]
+    n_workers = workers or available_cpus()
+    env: dict[str, str] = {}
+    if scheduler is not None or PROCESSES_PER_CASE * min(n_workers, len(todo)) > available_cpus():
+        # more processes than CPUs (a cluster's workers are one per CPU): block, do not poll
+        env[LOCKSTEP_SPIN_ENV] = "0"
+    with contextlib.ExitStack() as stack:
+        if scheduler is None:
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=min(n_workers, len(todo)), threads_per_worker=1, processes=True,
+                dashboard_address=None, silence_logs=DASK_LOG_LEVEL))
+            client = stack.enter_context(Client(cluster))
+        else:
+            client = stack.enter_context(Client(scheduler))
+        futures = {}
+        token = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
+        for c in todo:
+            f = client.submit(run_case, c, str(scenario), str(cases_dir), timeout_s, env,
+                              key=f"case-{c['name']}-{token}", pure=False,
+                              retries=RETRIES)
+            futures[f] = c
+        done = len(rows)
+        try:
+            for f in as_completed(futures):
+                c = futures[f]
+                try:
+                    row = f.result()
+                except Exception as exc:
+                    row = error_row(c, f"{type(exc).__name__}: {exc}")
+                if row["status"] == STATUS_REFUSED:  # every case would be: stop here
+                    raise CaseRefusedError(row["error"])
+                rows[c["index"]] = row
+                done += 1
+                if progress is not None:
+                    progress(done, total, row)
+        except BaseException:
+            for f in futures:
+                f.cancel()
+            raise
+    _clear_attempts(cases_dir)  # a lost worker's attempt, stopped with it
+    return [rows[c["index"]] for c in cases]

@@ -1,0 +1,83 @@
+"""``thruster-hil campaign rerun`` and ``thruster-hil campaign margin``: one case again, and
+a requirement's margin on one key.
+
+- ``rerun CAMPAIGN_DIR CASE [--out RUN_DIR]``: the case's run again, from the campaign
+  folder alone (its ``scenario.toml`` copy and the case's ``case.json``); exit 0 if the
+  trace records equal the campaign's, 1 if not (:func:`bench.campaign.cli.rerun_case`).
+- ``margin SCENARIO --key KEY --toward VALUE --out DIR [--requirement NAME]
+  [--tolerance T] [--set KEY=VALUE ...]``: bisection from the scenario's value toward a failing one
+  (:mod:`bench.campaign.margin`); prints the boundary, its uncertainty, the margin and
+  the number of runs.
+Exit 2 on bad input, 3 if a run could not complete.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from dbc import options as opt
+from dbc.errors import ConfigError, RunError
+from dbc.options import StrictParser
+
+EXIT_BAD_INPUT, EXIT_RUN_ERROR = 2, 3
+
+
+def _parser() -> StrictParser:
+    p = StrictParser(prog="thruster-hil campaign", description=__doc__.split("\n")[0])
+    sub = p.add_subparsers(dest="tool", required=True, metavar="TOOL")
+    r = sub.add_parser("rerun", help="run one case of a campaign again, byte for byte")
+    r.add_argument("campaign_dir", metavar="CAMPAIGN_DIR",
+                   type=opt.text("CAMPAIGN_DIR", "a campaign folder"))
+    r.add_argument("case", metavar="CASE", type=opt.text("CASE", "a case name, e.g. 0007"))
+    r.add_argument("--out", type=opt.text("--out", "a folder path"),
+                   help="the rerun's run folder (default CAMPAIGN_DIR/reruns/CASE)")
+    m = sub.add_parser("margin", help="bisect one key for the value where a requirement "
+                       "starts failing")
+    m.add_argument("scenario", metavar="SCENARIO", type=opt.text("SCENARIO", "a scenario file"))
+    m.add_argument("--key", required=True, type=opt.text("--key", "a scenario key or alias"),
+                   help="a scenario key (bus.fsw_response_delay_s) or a campaign alias "
+                   "(latency, thrust_scale, open_delay, ...: docs/campaigns.md)")
+    m.add_argument("--toward", required=True, type=opt.number("--toward"),
+                   help="a value of KEY at which the requirement fails")
+    m.add_argument("--requirement", default="passed",
+                   type=opt.text("--requirement", "an expectation name"),
+                   help="an expectation of the scenario, e.g. settling_time_s "
+                   "(default passed: all of them)")
+    m.add_argument("--tolerance", type=opt.number("--tolerance", 0.0, lo_open=True),
+                   help="stop when the bracket is this narrow (default 1/64 of its start)")
+    m.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scenario value for every step, as `run --set`")
+    m.add_argument("--out", required=True, type=opt.text("--out", "a folder path"))
+    return p
+
+
+def main(argv: list[str]) -> int:
+    """Command line (module docstring)."""
+    args = opt.parse_or_exit_code(_parser(), argv)
+    if isinstance(args, int):
+        return args
+    try:
+        if args.tool == "rerun":
+            from bench.campaign.cli import rerun_case
+
+            return rerun_case(Path(args.campaign_dir), args.case,
+                              None if args.out is None else Path(args.out))
+        from bench.campaign.margin import margin_search
+
+        r = margin_search(Path(args.scenario), args.key, args.toward, args.requirement,
+                          Path(args.out), args.tolerance, tuple(args.overrides))
+    except ConfigError as exc:
+        print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except RunError as exc:
+        print(f"thruster-hil campaign: run error: {exc}", file=sys.stderr)
+        return EXIT_RUN_ERROR
+    if r.get("boundary") is None:
+        print(f"margin of {r['key']} for {r['requirement']}: {r['note']} ({r['runs']} runs)")
+    else:
+        rel = "" if r["margin_relative"] is None else f" ({100 * r['margin_relative']:+.1f} %)"
+        print(f"margin of {r['key']} for {r['requirement']}: fails from {r['boundary']:.6g} "
+              f"± {r['uncertainty']:.2g} (nominal {r['nominal']:g}): margin "
+              f"{r['margin']:+.6g}{rel}; {r['runs']} runs; {Path(args.out) / 'margin.json'}")
+    return 0

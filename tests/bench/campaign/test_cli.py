@@ -1,0 +1,51 @@
+"""The campaign command's refusals: before any process starts, one line naming the case,
+the key and the value; a folder holding another campaign is not overwritten."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from bench.operator.campaign import EXIT_BAD_INPUT, main
+
+REPO = Path(__file__).resolve().parents[3]
+QUICKSTART = REPO / "scenarios" / "quickstart.toml"
+
+
+def _write(tmp: Path, body: str) -> Path:
+    f = tmp / "c.toml"
+    f.write_text(f'[campaign]\nscenario = "{QUICKSTART}"\ncases = 3\n{body}', encoding="utf-8")
+    return f
+
+
+def test_an_impossible_draw_is_refused_naming_case_and_key(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Ix scaled x10 breaks the triangle inequality: exit 2 naming case 0000 and the inertia."""
+    f = _write(tmp_path, '[[dispersions]]\nname = "inertia_xx"\ndist = "sweep"\n'
+               'values = [10.0]\napply = "scale"\n')
+    code = main([str(f), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == EXIT_BAD_INPUT, err
+    assert "case 0000" in err and "inertia_B_kgm2" in err and "narrow its distribution" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_legacy_options_are_refused_with_a_campaign_file(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--fault-time belongs to the campaign file's [campaign] table: exit 2 saying so."""
+    f = _write(tmp_path, "")
+    code = main([str(f), "--out", str(tmp_path / "out"), "--fault-time", "3"])
+    assert code == EXIT_BAD_INPUT and "fault_time_s" in capsys.readouterr().err
+
+
+def test_a_folder_holding_something_else_is_refused(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--out with files of something else: exit 2, the files untouched."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "keep.txt").write_text("mine", encoding="utf-8")
+    f = _write(tmp_path, '[[dispersions]]\nname = "latency"\ndist = "sweep"\nvalues = [0.001]\n')
+    code = main([str(f), "--out", str(out)])
+    assert code == EXIT_BAD_INPUT and "a new or empty folder" in capsys.readouterr().err
+    assert (out / "keep.txt").read_text(encoding="utf-8") == "mine"
