@@ -272,7 +272,7 @@ def main() -> None:
                     result[name] = globals()[name](scratch, env, args)
                 except (RuntimeError, OSError, ValueError) as exc:  # the others still run
                     result[name] = {"error": str(exc)}
-                print(f"{name}: {json.dumps(result[name])[:300]}", file=sys.stderr, flush=True)
+                print(f"{name}: {json.dumps(result[name])}", file=sys.stderr, flush=True)
     print(json.dumps(result, indent=2))
 
 

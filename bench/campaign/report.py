@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.campaign.case_run import METRICS
+from bench.campaign.stats import SIGNIFICANCE
 from bench.operator.report_html import STYLE, Raw, html_table
 from dbc.records import write_record
 
@@ -91,7 +92,8 @@ def _figures(rows: list[dict[str, Any]], stats: dict[str, Any]) -> list[Raw]:
         imgs.append(_png(fig))
         sens = stats["sensitivity"].get(fig_name) or {}
         if sens:
-            key, rho = next(iter(sens.items()))
+            key, s = next(iter(sens.items()))
+            rho = s["rho"]
             pts = [(r["values"][key], r["figures"][fig_name]) for r in ok
                    if key in r["values"] and r["figures"].get(fig_name) is not None]
             fig, ax = plt.subplots(figsize=FIGURE_SIZE_IN)
@@ -117,7 +119,7 @@ def write_html(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any],
               f"[{v['ci_low']:.3f}, {v['ci_high']:.3f}]"] for k, v in pr.items()]
     pct = [[k, *(f"{v[f'p{p}']:.4g}" for p in (5, 50, 95, 99)), f"{v['max']:.4g}", v["n"]]
            for k, v in stats["percentiles"].items()]
-    sens = [[k, ", ".join(f"{key} {rho:+.2f}" for key, rho in
+    sens = [[k, ", ".join(f"{key} {s['rho']:+.2f} (p {s['p']:.2g})" for key, s in
                           list(v.items())[:SHOWN_SENSITIVITIES]) or "none"]
             for k, v in stats["sensitivity"].items()]
     worst = [[k, _link(w["name"]), f"{w['value']:.4g}", w["seed"],
@@ -137,7 +139,9 @@ def write_html(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any],
         + html_table(["requirement", "passed", "cases", "rate", "95 % interval"], rates)
         + "<h2>Figures</h2>"
         + html_table(["figure", "p5", "p50", "p95", "p99", "max", "cases"], pct)
-        + f"<div>{imgs}</div><h2>Sensitivity (Spearman rank correlation)</h2>"
+        + f"<div>{imgs}</div><h2>Sensitivity (Spearman rank correlation)</h2><p>With few "
+        "cases and many dispersed keys some correlations are large by chance: read those "
+        f"with p above {SIGNIFICANCE:g} as noise.</p>"
         + html_table(["figure", "most sensitive dispersed keys"], sens)
         + "<h2>Worst cases</h2>"
         + html_table(["figure", "case", "value", "seed", "dispersed values"], worst)

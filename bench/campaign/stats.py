@@ -9,7 +9,9 @@ cases, sensitivities. Pure (rows in, dicts out).
 - Percentiles (:data:`PERCENTILES`, linear interpolation) of every figure.
 - The worst cases of each figure (largest values first) with their seeds and values.
 - Sensitivity: Spearman's rank correlation of each figure with each dispersed value
-  (ties get mean ranks; a constant column has none), ``scipy.stats.spearmanr``.
+  (ties get mean ranks; a constant column has none), ``scipy.stats.spearmanr``, with its
+  two-sided p-value: with few cases and many dispersed keys, some correlations are large
+  by chance (read those with p above :data:`SIGNIFICANCE` as noise).
 Cases recorded as errors are counted (``errors``) and left out of every rate and figure.
 """
 
@@ -25,6 +27,7 @@ Z_95 = 1.959963984540054
 """Standard normal quantile of (1 + CONFIDENCE)/2."""
 PERCENTILES = (5, 50, 95, 99)
 MIN_SENSITIVITY_CASES = 3
+SIGNIFICANCE = 0.05
 """A rank correlation needs at least this many cases with both values."""
 
 
@@ -92,8 +95,9 @@ def worst_cases(rows: list[dict[str, Any]], count: int) -> dict[str, list[dict[s
     return out
 
 
-def sensitivities(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]]:
-    """Per figure, per dispersed key: Spearman's rank correlation (module docstring)."""
+def sensitivities(rows: list[dict[str, Any]]) -> dict[str, dict[str, dict[str, float]]]:
+    """Per figure, per dispersed key: Spearman's ``rho`` and its ``p`` (module docstring),
+    largest |rho| first."""
     from scipy.stats import spearmanr
 
     ok = _ok(rows)
@@ -101,9 +105,9 @@ def sensitivities(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]]:
     for r in ok:
         keys.update(dict.fromkeys(k for k, v in r["values"].items()
                                   if isinstance(v, int | float) and not isinstance(v, bool)))
-    out: dict[str, dict[str, float]] = {}
+    out: dict[str, dict[str, dict[str, float]]] = {}
     for fig in _figure_columns(rows):
-        per: dict[str, float] = {}
+        per: dict[str, dict[str, float]] = {}
         for key in keys:
             pairs = [(r["values"][key], r["figures"][fig]) for r in ok
                      if r["figures"].get(fig) is not None and key in r["values"]]
@@ -112,10 +116,11 @@ def sensitivities(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]]:
             x, y = np.array(pairs, dtype=float).T
             if np.ptp(x) == 0.0 or np.ptp(y) == 0.0:
                 continue
-            rho = float(spearmanr(x, y).statistic)
+            res = spearmanr(x, y)
+            rho, p = float(res.statistic), float(res.pvalue)
             if math.isfinite(rho):
-                per[key] = rho
-        out[fig] = dict(sorted(per.items(), key=lambda kv: -abs(kv[1])))
+                per[key] = {"rho": rho, "p": p}
+        out[fig] = dict(sorted(per.items(), key=lambda kv: -abs(kv[1]["rho"])))
     return out
 
 

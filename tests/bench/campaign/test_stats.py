@@ -8,7 +8,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-from bench.campaign.stats import Z_95, pass_rates, sensitivities, wilson_interval, worst_cases
+from bench.campaign.stats import (
+    SIGNIFICANCE,
+    Z_95,
+    pass_rates,
+    sensitivities,
+    wilson_interval,
+    worst_cases,
+)
 
 TOL = 1e-12
 ROOT_TOL = 1e-9  # numpy.roots' accuracy on a quadratic with coefficients near 1
@@ -64,6 +71,14 @@ def test_worst_cases_largest_first_with_seeds() -> None:
 def test_rank_correlation_of_monotone_and_reversed_data() -> None:
     """A figure increasing with x: rho = +1; a constant key or a string: not reported."""
     rows = [_row(i, True, float(i) ** 3, float(i)) for i in range(6)]
-    assert sensitivities(rows)["f"] == pytest.approx({"x": 1.0}, abs=TOL)
+    s = sensitivities(rows)["f"]
+    assert list(s) == ["x"] and s["x"]["rho"] == pytest.approx(1.0, abs=TOL)
+    assert s["x"]["p"] < SIGNIFICANCE
     rows = [_row(i, True, -float(i), float(i)) for i in range(6)]
-    assert sensitivities(rows)["f"]["x"] == pytest.approx(-1.0, abs=TOL)
+    assert sensitivities(rows)["f"]["x"]["rho"] == pytest.approx(-1.0, abs=TOL)
+
+
+def test_rank_correlation_p_value_of_unrelated_data() -> None:
+    """A figure alternating with x (rho 0.09 on 6 cases) is not significant."""
+    rows = [_row(i, True, float(i % 2), float(i)) for i in range(6)]
+    assert sensitivities(rows)["f"]["x"]["p"] > SIGNIFICANCE
