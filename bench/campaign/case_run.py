@@ -98,7 +98,8 @@ METRICS = ("settling_time_s", "steady_state_attitude_error_deg", "final_attitude
 """The figures every row carries (None where the run has none)."""
 
 
-def result_row(case: dict[str, Any], s: dict[str, Any], run_dir: Path) -> dict[str, Any]:
+def result_row(case: dict[str, Any], s: dict[str, Any], run_dir: Path,
+               attempt: int = 1) -> dict[str, Any]:
     """A case's result: what it was, what its run reported, its requirements."""
     lat = (s.get("latency_us") or {}).get("sensor_to_command") or {}
     fdir = s.get("fdir") or {}
@@ -119,17 +120,17 @@ def result_row(case: dict[str, Any], s: dict[str, Any], run_dir: Path) -> dict[s
         "requirements": reqs, "figures": figures, "values": dict(case["values"]),
         "abnormal": sorted(s.get("abnormal") or {}),
         "trace_sha256": trace_digest(run_dir),
-        "wall_time_s": _metric(s, "wall_time_s"),
+        "wall_time_s": _metric(s, "wall_time_s"), "attempts": attempt,
     }
 
 
-def error_row(case: dict[str, Any], message: str) -> dict[str, Any]:
+def error_row(case: dict[str, Any], message: str, attempts: int = 1) -> dict[str, Any]:
     """The row of a case that could not complete (recorded, never dropped)."""
     return {"case": case["index"], "name": case["name"], "vehicle": case["vehicle"],
             "seed": case["seed"], "status": STATUS_ERROR, "error": message,
             "failure": case.get("failure"), "passed": False, "requirements": {},
             "figures": dict.fromkeys(METRICS), "values": dict(case["values"]),
-            "abnormal": [], "trace_sha256": None, "wall_time_s": None}
+            "abnormal": [], "trace_sha256": None, "wall_time_s": None, "attempts": attempts}
 
 
 def _stop(p: subprocess.Popen[str]) -> None:
@@ -144,13 +145,14 @@ def _stop(p: subprocess.Popen[str]) -> None:
 
 
 def run_case(case: dict[str, Any], scenario: str, cases_dir: str, timeout_s: float,
-             env_extra: dict[str, str]) -> dict[str, Any]:
-    """Run ``case`` of the campaign (module docstring); its result row."""
+             env_extra: dict[str, str], attempt: int = 1) -> dict[str, Any]:
+    """Run ``case`` of the campaign (module docstring); its result row (``attempt``: which
+    attempt this is, recorded in the row)."""
     final = Path(cases_dir) / case["name"]
-    attempt = Path(cases_dir) / f"{case['name']}{ATTEMPT_MARK}{uuid.uuid4().hex[:8]}"
-    attempt.mkdir(parents=True)
-    write_record(attempt / CASE_FILE, case)
-    run_dir = attempt / "run"
+    folder = Path(cases_dir) / f"{case['name']}{ATTEMPT_MARK}{uuid.uuid4().hex[:8]}"
+    folder.mkdir(parents=True)
+    write_record(folder / CASE_FILE, case)
+    run_dir = folder / "run"
     env = dict(os.environ, **env_extra)
     cmd = [sys.executable, "-m", "bench.operator.cli",
            *run_command(Path(scenario), case, run_dir)]
@@ -160,25 +162,25 @@ def run_case(case: dict[str, Any], scenario: str, cases_dir: str, timeout_s: flo
         _, err = p.communicate(timeout=timeout_s)
     except subprocess.TimeoutExpired:
         _stop(p)
-        shutil.rmtree(attempt, ignore_errors=True)
+        shutil.rmtree(folder, ignore_errors=True)
         raise CaseTimeoutError(f"case {case['name']}: still running after {timeout_s:g} s "
                           "(stopped)") from None
     except BaseException:
         _stop(p)
-        shutil.rmtree(attempt, ignore_errors=True)
+        shutil.rmtree(folder, ignore_errors=True)
         raise
     summary = run_dir / "summary.json"
     if p.returncode == EXIT_BAD_INPUT or not summary.exists():
         tail = " | ".join(err.strip().splitlines()[-STDERR_TAIL_LINES:]) or "(no output)"
-        shutil.rmtree(attempt, ignore_errors=True)
+        shutil.rmtree(folder, ignore_errors=True)
         message = f"case {case['name']}: run exited {p.returncode}: {tail}"
         if p.returncode == EXIT_BAD_INPUT:
-            return dict(error_row(case, message), status=STATUS_REFUSED)
+            return dict(error_row(case, message, attempt), status=STATUS_REFUSED)
         raise RunError(message)
     s = json.loads(summary.read_text(encoding="utf-8"))
-    row = result_row(case, s, run_dir)
-    write_record(attempt / RESULT_FILE, row)
+    row = result_row(case, s, run_dir, attempt)
+    write_record(folder / RESULT_FILE, row)
     if final.exists():  # an earlier attempt that finished after all: this one replaces it
         shutil.rmtree(final)
-    os.replace(attempt, final)
+    os.replace(folder, final)
     return row

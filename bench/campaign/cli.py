@@ -179,7 +179,8 @@ def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str
     print(f"campaign {spec.name}: {len(cases)} cases of {spec.scenario.name} on {where}; "
           f"folder {out}", flush=True)
     cpu0, t0 = os.times(), time.monotonic()
-    rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, workers, _progress())
+    rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, workers, _progress(),
+                     notice=lambda line: print(line, file=sys.stderr, flush=True))
     wall = time.monotonic() - t0
     cpu1 = os.times()
     cpu_s = ((cpu1.children_user - cpu0.children_user)

@@ -8,9 +8,10 @@ scheduler, a ``distributed.LocalCluster`` of one single-threaded worker process 
 (``dask scheduler``, ``dask worker``), whose workers have the project installed and see
 ``out`` at the same path.
 
-- A case that raises (a crash, a timeout) is retried once (Dask ``retries=1``); a case
-  whose worker dies is rescheduled by Dask; after that it is recorded as an error row,
-  never dropped. A refused input (exit 2) is not retried.
+- A case that raises (a crash, a timeout) is submitted again once, and ``notice`` says
+  so (the console); a case whose worker dies is rescheduled by Dask; after that it is
+  recorded as an error row (``attempts``: how many ran), never dropped. A refused input
+  (exit 2) is not retried: it stops the campaign.
 - Resume: a case whose ``cases/NAME/result.json`` exists with the same case is not run
   again; stale attempt folders (a lost worker's, an interrupted campaign's) are removed
   before and after.
@@ -73,7 +74,8 @@ def _clear_attempts(cases_dir: Path) -> None:
 
 def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s: float,
               scheduler: str | None = None, workers: int | None = None,
-              progress: Progress | None = None) -> list[dict[str, Any]]:
+              progress: Progress | None = None,
+              notice: Callable[[str], None] = print) -> list[dict[str, Any]]:
     """Every case's row, in case order (module docstring)."""
     from distributed import Client, LocalCluster, as_completed
 
@@ -101,21 +103,30 @@ def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s:
             client = stack.enter_context(Client(cluster))
         else:
             client = stack.enter_context(Client(scheduler))
-        futures = {}
         token = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
-        for c in todo:
-            f = client.submit(run_case, c, str(scenario), str(cases_dir), timeout_s, env,
-                              key=f"case-{c['name']}-{token}", pure=False,
-                              retries=RETRIES)
-            futures[f] = c
+
+        def submit(c: dict[str, Any], attempt: int) -> Any:
+            return client.submit(run_case, c, str(scenario), str(cases_dir), timeout_s, env,
+                                 attempt, key=f"case-{c['name']}-{token}-{attempt}",
+                                 pure=False)
+
+        futures = {submit(c, 1): (c, 1) for c in todo}
         done = len(rows)
+        pending = as_completed(list(futures))
         try:
-            for f in as_completed(futures):
-                c = futures[f]
+            for f in pending:
+                c, attempt = futures.pop(f)
                 try:
                     row = f.result()
                 except Exception as exc:
-                    row = error_row(c, f"{type(exc).__name__}: {exc}")
+                    why = f"{type(exc).__name__}: {exc}"
+                    if attempt <= RETRIES:
+                        notice(f"case {c['name']}: attempt {attempt} failed ({why}); retrying")
+                        nxt = submit(c, attempt + 1)
+                        futures[nxt] = (c, attempt + 1)
+                        pending.add(nxt)
+                        continue
+                    row = error_row(c, f"{why} (after {attempt} attempts)", attempt)
                 if row["status"] == STATUS_REFUSED:  # every case would be: stop here
                     raise CaseRefusedError(row["error"])
                 rows[c["index"]] = row

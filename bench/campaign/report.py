@@ -41,7 +41,8 @@ def csv_columns(rows: list[dict[str, Any]]) -> list[str]:
         vals.update(dict.fromkeys(r["values"]))
     return (["case", "name", "vehicle", "seed", "status", "failure_kind", "failure_thruster",
              "passed"] + [f"req:{k}" for k in reqs] + list(METRICS)
-            + [f"value:{k}" for k in vals] + ["trace_sha256", "wall_time_s", "error", "run_dir"])
+            + [f"value:{k}" for k in vals]
+            + ["trace_sha256", "wall_time_s", "attempts", "error", "run_dir"])
 
 
 def _flat(r: dict[str, Any]) -> dict[str, Any]:
@@ -49,7 +50,8 @@ def _flat(r: dict[str, Any]) -> dict[str, Any]:
     out = {"case": r["case"], "name": r["name"], "vehicle": r["vehicle"], "seed": r["seed"],
            "status": r["status"], "failure_kind": f[0], "failure_thruster": f[1],
            "passed": r["passed"], "trace_sha256": r["trace_sha256"],
-           "wall_time_s": r["wall_time_s"], "error": r["error"],
+           "wall_time_s": r["wall_time_s"], "attempts": r.get("attempts"),
+           "error": r["error"],
            "run_dir": f"cases/{r['name']}/run"}
     out.update({f"req:{k}": v for k, v in r["requirements"].items()})
     out.update(r["figures"])

@@ -4,6 +4,9 @@ a requirement's margin on one key.
 - ``rerun CAMPAIGN_DIR CASE [--out RUN_DIR]``: the case's run again, from the campaign
   folder alone (its ``scenario.toml`` copy and the case's ``case.json``); exit 0 if the
   trace records equal the campaign's, 1 if not (:func:`bench.campaign.cli.rerun_case`).
+- ``minimize CAMPAIGN_DIR CASE [--out DIR] [--max-runs N]``: the smallest set of a failing
+  case's dispersed values that still fails, the others at nominal
+  (:mod:`bench.campaign.minimize`).
 - ``margin SCENARIO --key KEY --toward VALUE --out DIR [--requirement NAME]
   [--tolerance T] [--set KEY=VALUE ...]``: bisection from the scenario's value toward a failing one
   (:mod:`bench.campaign.margin`); prints the boundary, its uncertainty, the margin and
@@ -13,14 +16,17 @@ Exit 2 on bad input, 3 if a run could not complete.
 
 from __future__ import annotations
 
+import argparse
 import sys
 from pathlib import Path
 
+from bench.campaign.minimize import DEFAULT_MAX_RUNS
 from dbc import options as opt
 from dbc.errors import ConfigError, RunError
 from dbc.options import StrictParser
 
 EXIT_BAD_INPUT, EXIT_RUN_ERROR = 2, 3
+MAX_MINIMIZE_RUNS = 10_000
 
 
 def _parser() -> StrictParser:
@@ -32,6 +38,17 @@ def _parser() -> StrictParser:
     r.add_argument("case", metavar="CASE", type=opt.text("CASE", "a case name, e.g. 0007"))
     r.add_argument("--out", type=opt.text("--out", "a folder path"),
                    help="the rerun's run folder (default CAMPAIGN_DIR/reruns/CASE)")
+    z = sub.add_parser("minimize", help="the smallest set of a failing case's dispersions "
+                       "that still fails")
+    z.add_argument("campaign_dir", metavar="CAMPAIGN_DIR",
+                   type=opt.text("CAMPAIGN_DIR", "a campaign folder"))
+    z.add_argument("case", metavar="CASE", type=opt.text("CASE", "a case name, e.g. 0007"))
+    z.add_argument("--out", type=opt.text("--out", "a folder path"),
+                   help="folder for the trials and minimal.json (default "
+                   "CAMPAIGN_DIR/minimal/CASE)")
+    z.add_argument("--max-runs", type=opt.integer("--max-runs", 1, MAX_MINIMIZE_RUNS),
+                   default=DEFAULT_MAX_RUNS,
+                   help=f"give up after this many runs (default {DEFAULT_MAX_RUNS})")
     m = sub.add_parser("margin", help="bisect one key for the value where a requirement "
                        "starts failing")
     m.add_argument("scenario", metavar="SCENARIO", type=opt.text("SCENARIO", "a scenario file"))
@@ -52,6 +69,23 @@ def _parser() -> StrictParser:
     return p
 
 
+def _minimize(args: argparse.Namespace) -> int:
+    from bench.campaign.minimize import minimize
+
+    d = Path(args.campaign_dir)
+    out = Path(args.out) if args.out else d / "minimal" / args.case
+    r = minimize(d, args.case, out, args.max_runs)
+    if r["minimal"] is None or not r["minimal"]:
+        print(f"minimal failure of {args.case}: {r['note']} ({r['runs']} runs)")
+    else:
+        print(f"minimal failure of {args.case}: {len(r['minimal'])} of {r['dispersed']} "
+              f"dispersed values still fail ({r['runs']} runs; the rest at nominal):")
+        for k, v in r["minimal"].items():
+            print(f"  {k} = {v}")
+    print(f"  {out / 'minimal.json'}")
+    return 0
+
+
 def main(argv: list[str]) -> int:
     """Command line (module docstring)."""
     args = opt.parse_or_exit_code(_parser(), argv)
@@ -63,6 +97,8 @@ def main(argv: list[str]) -> int:
 
             return rerun_case(Path(args.campaign_dir), args.case,
                               None if args.out is None else Path(args.out))
+        if args.tool == "minimize":
+            return _minimize(args)
         from bench.campaign.margin import margin_search
 
         r = margin_search(Path(args.scenario), args.key, args.toward, args.requirement,

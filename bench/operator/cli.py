@@ -315,7 +315,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="only print the frame for cansend, with this alive counter")
     cp = sub.add_parser("campaign", help="a campaign file's Monte Carlo / sweep on Dask, or "
                         "every single-thruster failure of a scenario; `campaign rerun DIR "
-                        "CASE` reruns one case, `campaign margin` finds a requirement's margin")
+                        "CASE` reruns one case, `campaign minimize DIR CASE` finds a "
+                        "failure's minimal dispersions, `campaign margin` finds a "
+                        "requirement's margin")
     from bench.operator.campaign import add_arguments
 
     add_arguments(cp, default_jobs=1)
@@ -441,7 +443,7 @@ def _add_timing_parser(sub: Any) -> None:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``thruster-hil`` console script."""
     argv = sys.argv[1:] if argv is None else argv
-    if argv[:2] in (["campaign", "rerun"], ["campaign", "margin"]):
+    if argv[:1] == ["campaign"] and argv[1:2] in (["rerun"], ["margin"], ["minimize"]):
         from bench.campaign.tools import main as campaign_tool
 
         return campaign_tool(argv[1:])

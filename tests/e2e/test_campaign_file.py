@@ -17,6 +17,7 @@ from tests.e2e.conftest import RUN_TIMEOUT_S
 REPO = Path(__file__).resolve().parents[2]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
 CASES = 3
+POLL_S = 0.05  # polling the campaign folder for its first finished case
 
 pytestmark = pytest.mark.slow
 
@@ -65,3 +66,82 @@ def test_small_monte_carlo_reruns_and_resumes(tmp_path: Path, runtime: Path) -> 
     before = data["cases"]
     assert [(r["name"], r["trace_sha256"], r["figures"]) for r in after] == \
         [(r["name"], r["trace_sha256"], r["figures"]) for r in before]
+
+
+def test_minimal_failure_names_the_dispersion_that_fails(tmp_path: Path, runtime: Path) -> None:
+    """A 90 ms command latency fails the 12 s quickstart, a 0.1 deg/s initial rate does not:
+    the minimal failure keeps the latency alone, the rate back at nominal."""
+    f = tmp_path / "f.toml"
+    f.write_text(
+        f'[campaign]\nscenario = "{QUICKSTART}"\nstudy = "factorial"\n'
+        'set = ["scenario.duration_s=12.0", "expectations.steady_state_window_s=4.0"]\n'
+        '[[dispersions]]\nname = "initial_rate"\ndist = "sweep"\nvalues = [0.1]\n'
+        '[[dispersions]]\nname = "latency"\ndist = "sweep"\nvalues = [0.09]\n',
+        encoding="utf-8")
+    out = tmp_path / "out"
+    run = _hil(["campaign", str(f), "--out", str(out)], runtime)
+    assert run.returncode == 1, run.stdout[-2000:] + run.stderr[-2000:]  # the one case fails
+    m = _hil(["campaign", "minimize", str(out), "0000", "--out", str(tmp_path / "m")], runtime)
+    assert m.returncode == 0, m.stderr[-2000:]
+    r = json.loads((tmp_path / "m" / "minimal.json").read_text(encoding="utf-8"))
+    assert r["minimal"] == {"bus.fsw_response_delay_s": 0.09}, r
+    # as drawn (fails), at nominal (passes), without the rates (fails); without the latency
+    # is the nominal case again: not rerun
+    assert [t["passed"] for t in r["trials"]] == [False, True, False]
+
+
+def test_an_interrupted_campaign_resumes(tmp_path: Path, runtime: Path) -> None:
+    """Ctrl-C after the first case: the campaign stops (no case folder half-written); the
+    same command again runs only the cases missing and ends with every case once."""
+    import os
+    import signal
+    import time
+
+    cases = 6
+    f = tmp_path / "mc.toml"
+    f.write_text(
+        f'[campaign]\nscenario = "{QUICKSTART}"\ncases = {cases}\nseed = 3\n'
+        'set = ["scenario.duration_s=6.0", "expectations.steady_state_window_s=2.0"]\n'
+        '[[dispersions]]\nname = "latency"\ndist = "uniform"\nlow = 0.0005\nhigh = 0.003\n',
+        encoding="utf-8")
+    out = tmp_path / "out"
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime))
+    p = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", "campaign", str(f),
+                          "--out", str(out)], env=env, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + RUN_TIMEOUT_S
+    finished = out / "cases"
+    while not (finished.exists() and list(finished.glob("*/result.json"))):
+        assert p.poll() is None and time.monotonic() < deadline, "no case finished"
+        time.sleep(POLL_S)
+    p.send_signal(signal.SIGINT)
+    p.communicate(timeout=RUN_TIMEOUT_S)
+    done_before = {d.name for d in (out / "cases").glob("*") if (d / "result.json").exists()}
+    assert p.returncode != 0 and 1 <= len(done_before) < cases
+    assert not (out / "campaign.json").exists()
+    again = _hil(["campaign", str(f), "--out", str(out)], runtime)
+    assert again.returncode in (0, 1), again.stderr[-3000:]
+    rows = json.loads((out / "campaign.json").read_text(encoding="utf-8"))["cases"]
+    assert [r["name"] for r in rows] == [f"{i:04d}" for i in range(cases)]
+    assert all(r["status"] == "ok" for r in rows)
+    assert not [d for d in (out / "cases").iterdir() if ".attempt-" in d.name]
+
+
+def test_a_hung_case_is_retried_once_then_recorded_as_an_error(tmp_path: Path,
+                                                               runtime: Path) -> None:
+    """case_timeout_s = 1 s on 30 s cases: each case is stopped, retried, then listed as an
+    error (exit 3), none dropped, no run left behind."""
+    f = tmp_path / "hang.toml"
+    f.write_text(
+        f'[campaign]\nscenario = "{QUICKSTART}"\ncases = 2\ncase_timeout_s = 1.0\n'
+        'set = ["scenario.duration_s=30.0"]\n'
+        '[[dispersions]]\nname = "latency"\ndist = "sweep"\nvalues = [0.001]\n',
+        encoding="utf-8")
+    out = tmp_path / "out"
+    run = _hil(["campaign", str(f), "--out", str(out)], runtime)
+    assert run.returncode == 3, run.stdout[-2000:] + run.stderr[-2000:]
+    rows = json.loads((out / "campaign.json").read_text(encoding="utf-8"))["cases"]
+    assert [(r["name"], r["status"]) for r in rows] == [("0000", "error"), ("0001", "error")]
+    assert all("still running after 1 s" in r["error"] and r["attempts"] == 2 for r in rows)
+    assert run.stderr.count("retrying") == 2
+    assert "ERROR 0000" in run.stdout and not list((out / "cases").iterdir())

@@ -157,6 +157,9 @@ PLANS: dict[str, Plan] = {
     "thruster-hil campaign scenarios/campaigns/quickstart_smoke.toml --out runs/smoke": Plan(
         "run", "thruster-hil campaign scenarios/campaigns/quickstart_smoke.toml --out runs/smoke",
         RUN_OR_FAIL),
+    "thruster-hil campaign minimize runs/mc 0042": Plan(
+        "skip", why="needs a failing case of a 200-case campaign: tests/e2e/"
+        "test_campaign_file.py minimises a failing case of its own"),
     "thruster-hil campaign rerun runs/smoke 0003": Plan(
         "run", "thruster-hil campaign rerun runs/smoke 0003"),
     "thruster-hil campaign margin scenarios/three_axis_tracking_cascade.toml --key latency "
