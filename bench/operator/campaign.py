@@ -1,17 +1,20 @@
 """Single-failure campaign: every thruster stuck closed, then stuck open, one lockstep run each.
 
 ``python -m bench.operator.campaign SCENARIO --out DIR [--fault-time S] [--jobs N] [--kinds ...]``
-(also ``thruster-hil campaign``). Each run is the scenario with one ``[[faults]]`` entry
-appended, started as its own ``thruster-hil run`` process on a private portable-bus channel,
-``--jobs`` at a time (with more processes than CPUs, their lockstep waits block at once
-instead of polling first: see transport.lockstep). The flight software's FDIR report
+(also ``thruster-hil campaign``; a campaign file given there goes to
+:func:`bench.campaign.cli.run_campaign_file`). Each run is the scenario with one
+``[[faults]]`` entry appended (``--set faults=[...]``): a case of :mod:`bench.campaign`,
+run as its own ``thruster-hil run`` process on a private portable-bus channel, on a local
+Dask cluster of ``--jobs`` workers (with more processes than CPUs, their lockstep waits
+block at once instead of polling first: see transport.lockstep). The flight software's FDIR report
 (FSW_FDIR, in each summary.json) gives detection and isolation. Out, in DIR:
 ``campaign.csv`` (one row per run: thruster, kind, detected, detection time after the
 fault, isolated thruster, isolation correct, expectations met, final attitude and position
 error, propellant), ``campaign.json``, ``campaign.png`` (detection time per thruster and
 kind) and ``campaign.html`` (the figure and the table, each case linked to its run's
-report.html), plus every run folder. Exit 0 if every run detected and isolated its failure and met
-the scenario's expectations, 1 if not, 2 on bad input, 3 if a run could not complete.
+report.html), plus every run folder (``cases/KIND_TNN/run``). Exit 0 if every run detected
+and isolated its failure and met the scenario's expectations, 1 if not, 2 on bad input, 3
+if a run could not complete.
 """
 
 from __future__ import annotations
@@ -20,24 +23,22 @@ import argparse
 import csv
 import json
 import os
-import subprocess
 import sys
-import tempfile
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
-from bench.campaign.cli import run_campaign_file
+from bench.campaign.cases import build_cases
+from bench.campaign.cli import SCENARIO_COPY, run_campaign_file
 from bench.campaign.spec import is_campaign_file
 from bench.operator.report_html import campaign_html
 from bench.scenario.load import load_scenario
 from dbc import options as opt
+from dbc.datafile import parse_toml
 from dbc.errors import ConfigError, RunError
 from dbc.faults import STUCK_CLOSED, STUCK_OPEN
 from dbc.options import StrictParser
 from dbc.records import write_record
-from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
 KINDS = (STUCK_CLOSED, STUCK_OPEN)
 DEFAULT_FAULT_TIME_S = 10.0
@@ -46,41 +47,17 @@ COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruste
            "isolation_correct", "expectations_met", "final_attitude_error_deg",
            "final_position_error_m", "propellant_kg", "run_dir"]
 DPI = 110
-PROCESSES_PER_RUN = 2  # bench + flight software
 BAR_WIDTH = 30  # characters of the terminal progress bar
 MAX_JOBS = 64  # runs at a time: 128 processes, far more than the CPUs of any bench host
 
 
-def _run_one(scenario: Path, fault: str, out: Path, xdg: Path, spin_off: bool) -> dict[str, Any]:
-    out.mkdir(parents=True, exist_ok=True)
-    text = scenario.read_text(encoding="utf-8").rstrip() + "\n" + fault
-    sc_file = out / "campaign_scenario.toml"
-    sc_file.write_text(text, encoding="utf-8")
-    env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
-    if spin_off:  # more processes than CPUs: a polling wait would hold a CPU another needs
-        env.setdefault(LOCKSTEP_SPIN_ENV, "0")
-    # No --bus: a channel of the run's own, without the 0.25 s listen a named bus gets;
-    # no plots per case (0.3-0.7 s each): the campaign draws its own (campaign.png), and
-    # `thruster-hil report` draws any case's.
-    p = subprocess.run(
-        [sys.executable, "-m", "bench.operator.cli", "run", str(sc_file), "--no-plots",
-         "--out", str(out / "run")],
-        env=env, capture_output=True, text=True, check=False,
-    )
-    summary = out / "run" / "summary.json"
-    if p.returncode == EXIT_BAD_INPUT or not summary.exists():
-        last = (p.stderr.strip().splitlines() or ["(no output)"])[-1]
-        raise RunError(f"campaign run {out.name} failed (exit {p.returncode}): {last}")
-    return json.loads(summary.read_text(encoding="utf-8"))
-
-
-def _row(k: int, kind: str, fault_t_s: float, s: dict[str, Any], run_dir: Path) -> dict[str, Any]:
+def _row(k: int, kind: str, s: dict[str, Any], detection_s: float | None,
+         run_dir: Path) -> dict[str, Any]:
     fdir = s.get("fdir") or {}
     iso = fdir.get("failed_thruster")
-    t_det = fdir.get("detection_time_s")
     return {
         "thruster": k, "kind": kind, "detected": iso is not None,
-        "detection_time_s": None if t_det is None else round(t_det - fault_t_s, 3),
+        "detection_time_s": None if detection_s is None else round(detection_s, 3),
         "isolated_thruster": iso,
         "isolation_correct": iso == k and fdir.get("failure_kind") == kind,
         "expectations_met": bool(s.get("passed")),
@@ -97,42 +74,49 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
                  ) -> list[dict[str, Any]]:
     """Run every single-thruster failure of ``kinds``; write the CSV, JSON and PNG.
 
+    The cases are a campaign of one undispersed vehicle with ``failures`` (one
+    implementation of a case and of running cases: :mod:`bench.campaign`), on a local
+    Dask cluster of ``jobs`` workers; each case's run folder is ``out/cases/KIND_TNN/run``.
     ``progress(done, total, row)`` is called as each run finishes (in the order they
     finish); the rows returned are in case order.
     """
+    from bench.campaign.cli import case_dict
+    from bench.campaign.engine import run_cases
+    from bench.campaign.spec import CASE_TIMEOUT_BASE_S, CampaignSpec
+
     sc = load_scenario(scenario)
     if not 0.0 <= fault_t_s < sc.duration_s:  # also NaN
         raise ConfigError("command line", "--fault-time", fault_t_s,
                           f"a time in [0, {sc.duration_s:g}) s (the scenario's duration)")
     if not 1 <= jobs <= MAX_JOBS:
         raise ConfigError("command line", "--jobs", jobs, f"an integer in [1, {MAX_JOBS}]")
-    n = len(sc.thrusters)
+    spec = CampaignSpec(source="command line", name=scenario.stem, scenario=scenario.resolve(),
+                        study="monte_carlo", cases=1, seed=0, vary_seed=False,
+                        failures=tuple(kinds), fault_time_s=fault_t_s, dispersions=(),
+                        case_timeout_s=None, worst=0, keep="all")
+    text = scenario.read_text(encoding="utf-8")
+    data = parse_toml(text, str(scenario))
+    cases = [case_dict(c, spec) for c in build_cases(spec, data, len(sc.thrusters), sc.seed)]
     out.mkdir(parents=True, exist_ok=True)
-    cases = [(k, kind) for kind in kinds for k in range(n)]
-    spin_off = PROCESSES_PER_RUN * min(jobs, len(cases)) > available_cpus()
-    with tempfile.TemporaryDirectory(prefix="thil-campaign-") as tmp:
-        xdg = Path(tmp)
-        xdg.chmod(0o700)
+    (out / SCENARIO_COPY).write_text(text, encoding="utf-8")
 
-        def job(case: tuple[int, str]) -> dict[str, Any]:
-            k, kind = case
-            d = out / f"{kind}_T{k:02d}"
-            fault = f'\n[[faults]]\nt_s = {fault_t_s}\nkind = "{kind}"\nthruster = {k}\n'
-            return _row(k, kind, fault_t_s, _run_one(scenario, fault, d, xdg, spin_off),
-                        d / "run")
+    def row_of(r: dict[str, Any]) -> dict[str, Any]:
+        kind, k = r["failure"]
+        run_dir = out / "cases" / r["name"] / "run"
+        s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
+        return _row(k, kind, s, r["figures"]["detection_time_s"], run_dir)
 
-        with ThreadPoolExecutor(max_workers=jobs) as pool:
-            futures = [pool.submit(job, case) for case in cases]
-            try:
-                for done, fut in enumerate(as_completed(futures), start=1):
-                    row = fut.result()
-                    if progress is not None:
-                        progress(done, len(cases), row)
-                rows = [fut.result() for fut in futures]
-            except BaseException:  # one run failed: do not start the others
-                for fut in futures:
-                    fut.cancel()
-                raise
+    def show(done: int, total: int, r: dict[str, Any]) -> None:
+        if progress is not None:
+            progress(done, total, row_of(r))
+
+    results = run_cases(cases, out / SCENARIO_COPY, out, CASE_TIMEOUT_BASE_S + sc.duration_s,
+                        None, jobs, show,
+                        notice=lambda line: print(line, file=sys.stderr, flush=True))
+    bad = [r for r in results if r["status"] != "ok"]
+    if bad:
+        raise RunError(f"campaign run {bad[0]['name']} failed: {bad[0]['error']}")
+    rows = [row_of(r) for r in results]
     with open(out / "campaign.csv", "w", newline="", encoding="utf-8") as f:
         w = csv.DictWriter(f, fieldnames=COLUMNS)
         w.writeheader()

@@ -35,4 +35,5 @@ def test_a_run_that_fails_is_reported_with_its_reason(tmp_path: Path, runtime: P
     code = main([str(bad), "--out", str(tmp_path / "c"), "--kinds", "stuck_open"])
     err = capsys.readouterr().err
     assert code == EXIT_RUN_ERROR, err
-    assert "stuck_open_T00 failed (exit 2)" in err and "'pwfp'" in err and "Traceback" not in err
+    assert "case stuck_open_T00: run exited 2" in err and "'pwfp'" in err
+    assert "Traceback" not in err
