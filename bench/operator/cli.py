@@ -68,6 +68,7 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         bus_shared=args.bus is not None,
         record=args.record,
         plots=not args.no_plots,
+        monitor=args.monitor,
     )
     opts = dataclasses.replace(opts, out=prepare_run_folder(Path(args.out), args.replace)
                                if args.out else default_run_folder(sc.name))
@@ -91,9 +92,13 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         sys.stdout.flush()
         printed.append(True)
 
+    # the monitor owns a terminal while the run goes: no progress bar or alert lines under
+    # it (its event log shows them; the summary printed after it lists what was abnormal)
+    on_screen = not (opts.monitor and sys.stdout.isatty())
     try:
-        summary = run_scenario(sc, opts, progress_printer(), ready if alone else None,
-                               alerts.printer(), show)
+        summary = run_scenario(sc, opts, progress_printer() if on_screen else None,
+                               ready if alone else None,
+                               alerts.printer() if on_screen else None, show)
     except BaseException as exc:  # a failed or stopped run is a CI result too
         if junit is not None:
             write_junit(junit, opts.out, sc.name, f"{type(exc).__name__}: {exc}")
@@ -266,6 +271,10 @@ def build_parser() -> argparse.ArgumentParser:
         r.add_argument("--no-plots", action="store_true",
                        help="leave out the PNG plots (~0.3 s sooner: no matplotlib, no "
                        "drawing); `thruster-hil report RUN_DIR` draws them later")
+        r.add_argument("--monitor", action="store_true",
+                       help="show the live monitor (`thruster-hil monitor`) on the run's own "
+                       "bus while it runs; q closes it, the run goes on. Without a terminal "
+                       "its last picture is printed")
         r.add_argument("--replace", action="store_true",
                        help="let --out name a folder holding an earlier run, which is deleted")
         r.add_argument("--junit", type=opt.text("--junit", "a file path"), metavar="FILE",

@@ -9,14 +9,18 @@ count, period, jitter, rejects by cause, last decoded signals), the thrusters (c
 actual valve state, openings) and an event log. The reader never waits for the screen: a
 slow terminal skips redraws, never frames (the bus is read as fast as it delivers).
 ``--duration`` ends it (also for scripts); without a terminal it runs headless and prints
-the last picture as text. Textual (terminal UI library, its own test driver in tests/);
-q quits.
+the last picture as text. ``thruster-hil run --monitor`` shows it on the run's own bus while
+the run goes (:func:`watch_run`; one more listener on the bus). Textual (terminal UI
+library, its own test driver in tests/); q quits.
 """
 
 from __future__ import annotations
 
+import os
+import select
 import threading
 import time
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import can
@@ -117,8 +121,9 @@ def text_picture(s: dict[str, Any]) -> str:
 
 
 def make_app(reader: BusReader, title: str, refresh_s: float,
-             duration_s: float | None) -> Any:
-    """The textual application over ``reader`` (imported here: only the monitor needs it)."""
+             duration_s: float | None, stop_when: Callable[[], bool] | None = None) -> Any:
+    """The textual application over ``reader`` (imported here: only the monitor needs it);
+    it ends after ``duration_s``, on q, or at the first redraw where ``stop_when()``."""
     from textual.app import App, ComposeResult
     from textual.widgets import DataTable, Footer, Header, Log, Static
 
@@ -143,6 +148,7 @@ def make_app(reader: BusReader, title: str, refresh_s: float,
                 self.set_timer(duration_s, self.exit)
 
         def redraw(self) -> None:
+            done = stop_when is not None and stop_when()
             s = reader.snapshot()
             self.picture = s
             self.query_one("#vehicle", Static).update(vehicle_text(s))
@@ -154,8 +160,47 @@ def make_app(reader: BusReader, title: str, refresh_s: float,
             for line in s["events"][self.logged:]:
                 log.write_line(line)
             self.logged = len(s["events"])
+            if done:  # the last picture drawn, with every frame read before the end
+                self.exit()
 
     return MonitorApp()
+
+
+def process_ended(pid: int) -> Callable[[], bool]:
+    """A check that is true once process ``pid`` (a child of ours) has ended, without
+    reaping it (its parent still waits for it): a pidfd turns readable at its end."""
+    fd = os.pidfd_open(pid)
+
+    def ended() -> bool:
+        return bool(select.select([fd], [], [], 0.0)[0])
+
+    return ended
+
+
+def watch_run(bus_spec: str, pid: int, before_app: Callable[[], None] | None = None,
+              refresh_s: float = DEFAULT_REFRESH_S, db: Database | None = None) -> None:
+    """``thruster-hil run --monitor``: the monitor on a run's bus until the run's process
+    ``pid`` ends (or q: the run goes on). ``before_app`` runs once the bus is being read
+    (the supervisor's own preparations). Without a terminal it prints the last picture."""
+    import sys
+
+    from dbc.database import load_database
+    from transport.spec import open_bus
+
+    bus = open_bus(bus_spec)
+    reader = BusReader(bus, MonitorState(db or load_database()))
+    reader.start()
+    try:
+        if before_app is not None:
+            before_app()
+        app = make_app(reader, f"thruster-hil run --monitor {bus_spec}", refresh_s, None,
+                       process_ended(pid))
+        app.run(headless=not sys.stdout.isatty())
+        if not sys.stdout.isatty():
+            print(text_picture(reader.snapshot()), flush=True)
+    finally:
+        reader.stop()
+        bus.shutdown()
 
 
 def add_parser(sub: Any) -> None:

@@ -66,6 +66,7 @@ class RunOptions:
     bus_shared: bool = False  # a bus the user named: another run may be on it (probed)
     record: str = RECORD_STANDARD  # bench.results.record: compressed or plain files
     plots: bool = True  # the PNG plots (bench.operator.plots), drawn after the summary
+    monitor: bool = False  # the live monitor on the run's bus (bench.operator.monitor)
 
     def __post_init__(self) -> None:
         if self.mode not in ("lockstep", "realtime"):
@@ -158,7 +159,16 @@ def run_scenario(
             os._exit(code)
     # matplotlib loads while the flight software boots and the run goes (on the core the
     # bench leaves idle while it waits); the plots are drawn here once the bench is done
-    status, stop_signal = supervise(pid, preload_plots if opts.plots else None)
+    prepare = preload_plots if opts.plots else None
+    if opts.monitor:
+        from bench.operator.monitor import watch_run
+
+        def meanwhile() -> None:
+            watch_run(opts.bus, pid, prepare)
+
+        status, stop_signal = supervise(pid, meanwhile)
+    else:
+        status, stop_signal = supervise(pid, prepare)
     # a stop signal from here on waits for the folder to be complete (the plots too)
     with held_stop_signals() as held:
         reserve.release()

@@ -57,3 +57,24 @@ def test_monitor_counts_a_played_trace_as_the_run_summary(tmp_path: Path,
     for name, n in recorded.items():
         row = run.summary["frames"][name]
         assert n == (row["received"] if name.startswith(("THR_CMD", "FSW_")) else row["sent"])
+
+
+def test_run_monitor_shows_the_run_it_watches(tmp_path: Path, runtime_dir: Path) -> None:
+    """run --monitor (headless: no terminal): the monitor's last picture comes before the
+    verdict, counts every frame the bench sent as the summary does, and at least every
+    frame of the flight software's that the bench received."""
+    run = run_cli(["run", str(QUICKSTART), "--duration", SHORT_S, "--no-plots", "--monitor"],
+                  tmp_path / "run", runtime_dir)
+    assert run.returncode in (0, 1), run.stderr
+    assert run.stdout.index("thrusters (C commanded") < run.stdout.index("verdict:")
+    shown = {}
+    for line in run.stdout.splitlines():
+        cells = [c.strip() for c in line.split("|")]
+        if len(cells) > 2 and cells[1] in run.summary["frames"]:
+            shown[cells[1]] = int(cells[2])
+    assert shown, run.stdout
+    for name, row in run.summary["frames"].items():
+        if row["sender"] == "BENCH" and row["sent"]:
+            assert shown.get(name) == row["sent"], name
+        elif row["received"]:
+            assert shown.get(name, 0) >= row["received"], name
