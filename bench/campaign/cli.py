@@ -193,7 +193,8 @@ def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str
             "scheduler": scheduler, "cpu_s": cpu_s if scheduler is None else None,
             "cpu_use": cpu_s / (wall * available_cpus()) if scheduler is None and wall else None}
     stats["pruned"] = prune(out, rows, stats, spec.keep)
-    write_tables(out, rows, stats, meta)
+    if not write_tables(out, rows, stats, meta):
+        print("campaign.parquet left out: pyarrow is not installed (pip install pyarrow)")
     page = write_html(out, rows, stats, meta)
     for name, r in stats["pass_rates"].items():
         rate = "n/a" if r["rate"] is None else f"{r['rate']:.3f}"

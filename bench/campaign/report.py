@@ -4,6 +4,8 @@ Out, in the campaign folder:
 - ``campaign.csv``: one row per case: name, seed, status, pass/fail of every requirement,
   every figure, every dispersed value (column ``value:KEY``), the trace digest, its folder.
 - ``campaign.json``: the rows and :func:`bench.campaign.stats.statistics`.
+- ``campaign.parquet``: the CSV's table as Apache Parquet (where pyarrow is installed: the
+  ``[parquet]`` extra), typed columns for pandas, polars or DuckDB.
 - ``campaign.html``: pass rates with their 95 % intervals, percentiles, histograms of the
   figures, each figure against its most sensitive dispersed key, the sensitivity table,
   and the worst cases, each linked to its run's folder by a relative path (the campaign
@@ -60,13 +62,24 @@ def _flat(r: dict[str, Any]) -> dict[str, Any]:
 
 
 def write_tables(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any],
-                 meta: dict[str, Any]) -> None:
-    """campaign.csv and campaign.json."""
+                 meta: dict[str, Any]) -> bool:
+    """campaign.csv, campaign.json and, where pyarrow is installed (the ``[parquet]``
+    extra), campaign.parquet with the CSV's columns; whether the Parquet file was written."""
+    columns = csv_columns(rows)
+    flat = [_flat(r) for r in rows]
     with open(out / "campaign.csv", "w", newline="", encoding="utf-8") as f:
-        w = csv.DictWriter(f, fieldnames=csv_columns(rows))
+        w = csv.DictWriter(f, fieldnames=columns)
         w.writeheader()
-        w.writerows(_flat(r) for r in rows)
+        w.writerows(flat)
     write_record(out / "campaign.json", {"campaign": meta, "statistics": stats, "cases": rows})
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        return False
+    table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in flat])
+    pq.write_table(table, out / "campaign.parquet")
+    return True
 
 
 def _png(fig: Any) -> Raw:

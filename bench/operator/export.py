@@ -13,6 +13,11 @@ and units). Out, ``thruster-hil export RUN_DIR --format ...``:
   flight software or another node), then one column per signal headed ``SIGNAL [unit]``;
   integer signals (scale 1, offset 0) as integers, the others with 15 significant digits.
   Enumerations (the DBC's value tables: modes, fault kinds) stay numeric.
+- ``parquet``: a folder with one Apache Parquet file per message that occurs (pyarrow, the
+  optional extra ``[parquet]``): columns ``t_s`` (float64), ``direction`` (string) and one
+  per signal named as in the DBC, int64 for integer signals, float64 for the others, the
+  DBC's unit in each column's field metadata (``unit``) and the message's name and ID in
+  the file's metadata: for pandas (``pandas.read_parquet``), polars, DuckDB or Spark.
 
 A trace with no frame of the DBC is refused (a ConfigError: not a run's trace).
 Every frame of the trace is decoded as it was on the wire, the bench's and the flight
@@ -37,11 +42,15 @@ from cantools.database.can import Database
 from bench.results.record import run_file
 from dbc.errors import ConfigError
 
-FORMATS = ("csv", "mf4")
+FORMATS = ("csv", "mf4", "parquet")
 FLOAT64 = "d"
 MDF_VERSION = "4.10"
 CSV_DIGITS = ".15g"  # significant digits of a scaled value in the CSV
 MF4_HINT = "an installed asammdf (pip install asammdf, or pip install -e \".[mf4]\" here)"
+PARQUET_HINT = ("an installed pyarrow (pip install pyarrow, or pip install -e \".[parquet]\" "
+                "here)")
+NEEDS = {"mf4": ("asammdf", MF4_HINT), "parquet": ("pyarrow", PARQUET_HINT)}
+"""Formats that need an optional library: its module and the hint when it is missing."""
 
 
 @dataclass
@@ -160,6 +169,35 @@ def write_mf4(decoded: Decoded, db: Database, path: Path) -> Path:
     return path
 
 
+def write_parquet(decoded: Decoded, db: Database, folder: Path) -> list[Path]:
+    """One Parquet file per message that occurs (module docstring); the paths written."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError as exc:
+        raise ConfigError("command line", "--format", "parquet", PARQUET_HINT) from exc
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for m in db.messages:
+        s = decoded.series[m.name]
+        if not len(s.t_s):
+            continue
+        fields = [pa.field("t_s", pa.float64(), metadata={"unit": "s"}),
+                  pa.field("direction", pa.string())]
+        columns: list[Any] = [pa.array(s.t_s, pa.float64()),
+                              pa.array(["Rx" if rx else "Tx" for rx in s.rx], pa.string())]
+        for sig in m.signals:
+            kind = pa.int64() if _is_integer(sig) else pa.float64()
+            fields.append(pa.field(sig.name, kind, metadata={"unit": sig.unit or ""}))
+            col = pa.array(s.values[sig.name], pa.float64())
+            columns.append(col.cast(kind) if kind == pa.int64() else col)
+        schema = pa.schema(fields, metadata={"message": m.name, "frame_id": hex(m.frame_id)})
+        path = folder / f"{m.name}.parquet"
+        pq.write_table(pa.Table.from_arrays(columns, schema=schema), path)
+        written.append(path)
+    return written
+
+
 def add_parser(sub: Any) -> None:
     """The ``export`` subcommand of ``thruster-hil`` (its options, each checked)."""
     from dbc import options as opt
@@ -169,13 +207,15 @@ def add_parser(sub: Any) -> None:
     ex.add_argument("run_dir", metavar="RUN_DIR", type=opt.text("RUN_DIR", "a run folder"),
                     help="a run folder (with its trace.asc or trace.asc.gz)")
     ex.add_argument("--format", type=opt.choice("--format", FORMATS), default="csv",
-                    metavar="{csv,mf4}",
+                    metavar="{csv,mf4,parquet}",
                     help="csv: a folder with one CSV per message, a column per signal with "
                     "its unit; mf4: one ASAM MDF 4 file, a channel MESSAGE.SIGNAL per DBC "
-                    "signal (needs asammdf: pip install asammdf) (default csv)")
+                    "signal (needs asammdf: pip install asammdf); parquet: a folder with one "
+                    "Parquet file per message, units in the column metadata (needs pyarrow: "
+                    "pip install pyarrow) (default csv)")
     ex.add_argument("--out", type=opt.text("--out", "a file or folder path"),
-                    help="the MF4 file or the CSV folder (default: RUN_DIR/signals.mf4 or "
-                    "RUN_DIR/signals/)")
+                    help="the MF4 file, or the CSV or Parquet folder (default: "
+                    "RUN_DIR/signals.mf4, RUN_DIR/signals/ or RUN_DIR/signals_parquet/)")
 
 
 def run(args: Any) -> int:
@@ -183,14 +223,17 @@ def run(args: Any) -> int:
     from dbc.database import load_database
 
     run_dir = Path(args.run_dir)
-    if args.format == "mf4" and importlib.util.find_spec("asammdf") is None:
-        raise ConfigError("command line", "--format", "mf4", MF4_HINT)  # before decoding
+    if args.format in NEEDS and importlib.util.find_spec(NEEDS[args.format][0]) is None:
+        raise ConfigError("command line", "--format", args.format, NEEDS[args.format][1])
     db = load_database()
     decoded = decode_trace(run_dir, db)
     try:
         if args.format == "mf4":
             out = Path(args.out) if args.out else run_dir / "signals.mf4"
             paths = [write_mf4(decoded, db, out)]
+        elif args.format == "parquet":
+            out = Path(args.out) if args.out else run_dir / "signals_parquet"
+            paths = write_parquet(decoded, db, out)
         else:
             out = Path(args.out) if args.out else run_dir / "signals"
             paths = write_csv(decoded, db, out)

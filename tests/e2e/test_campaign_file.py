@@ -49,6 +49,11 @@ def test_small_monte_carlo_reruns_and_resumes(tmp_path: Path, runtime: Path) -> 
     assert all(r["status"] == "ok" and len(r["trace_sha256"]) == 64 for r in rows)
     data = json.loads((out / "campaign.json").read_text(encoding="utf-8"))
     assert data["statistics"]["pass_rates"]["passed"]["cases"] == CASES
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(out / "campaign.parquet")
+    assert table.column_names == list(rows[0]) and table.num_rows == CASES
+    assert table.column("trace_sha256").to_pylist() == [r["trace_sha256"] for r in rows]
     assert "value:thrusters.actual_thrust_scale[7]" in rows[0]
     html = (out / "campaign.html").read_text(encoding="utf-8")
     assert "href='cases/0000/run/'" in html  # 3 cases: each among the 5 worst, linked

@@ -186,7 +186,7 @@ ROWS: list[Row] = [
     _r(HIL, "export missing", "thruster-hil: error: command line: RUN_DIR = 'missing': "
        "expected an existing run folder"),
     _r(HIL, "export missing --format xls", "thruster-hil: error: command line: --format = "
-       "'xls': expected one of csv, mf4"),
+       "'xls': expected one of csv, mf4, parquet"),
     # thruster-hil monitor
     _r(HIL, "monitor --bus hilbus:bad-input-monitor", "thruster-hil: error: command line: "
        "--duration = None: expected a duration when the output is not a terminal (the "

@@ -8,7 +8,7 @@ from pathlib import Path
 import can
 import pytest
 
-from bench.operator.export import decode_trace, write_csv, write_mf4
+from bench.operator.export import decode_trace, write_csv, write_mf4, write_parquet
 from bench.wire.trace import TraceRecorder
 from dbc.database import load_database
 
@@ -79,6 +79,25 @@ def test_mf4_has_one_channel_per_dbc_signal(tmp_path: Path) -> None:
         rate = mdf.get("IMU_RATE.RateX")
         assert rate.unit == "rad/s" and list(rate.samples) == [v["RateX"] for v in sent]
         assert list(rate.timestamps) == [k * 0.01 for k in range(N_SAMPLES)]
+
+
+def test_parquet_has_a_typed_column_per_signal_with_its_unit(tmp_path: Path) -> None:
+    """One Parquet file per message that occurs: t_s, direction, a column per signal (int64
+    for integer signals), the DBC's unit in the field metadata, the values decoded."""
+    import pyarrow.parquet as pq
+
+    sent = _trace(tmp_path)
+    db = load_database()
+    (path,) = write_parquet(decode_trace(tmp_path, db), db, tmp_path / "pq")
+    table = pq.read_table(path)
+    imu = db.get_message_by_name("IMU_RATE")
+    assert path.name == "IMU_RATE.parquet" and table.num_rows == N_SAMPLES
+    assert table.column_names == ["t_s", "direction", *(s.name for s in imu.signals)]
+    assert table.schema.field("RateX").metadata == {b"unit": b"rad/s"}
+    assert table.column("RateX").to_pylist() == [v["RateX"] for v in sent]
+    assert str(table.schema.field("AliveCounter").type) == "int64"
+    assert table.column("AliveCounter").to_pylist() == list(range(N_SAMPLES))
+    assert table.schema.metadata[b"message"] == b"IMU_RATE"
 
 
 def test_a_trace_with_no_frame_of_the_dbc_is_refused(tmp_path: Path) -> None:
