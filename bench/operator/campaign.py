@@ -206,6 +206,18 @@ def _progress_printer() -> Callable[[int, int, dict[str, Any]], None]:
     return show
 
 
+def from_namespace(args: argparse.Namespace) -> int:
+    """``thruster-hil campaign``'s parsed options (:func:`add_arguments`) run as :func:`main`."""
+    argv = [args.scenario, "--out", args.out]
+    for option, value in (("--fault-time", args.fault_time), ("--jobs", args.jobs),
+                          ("--scheduler", args.scheduler)):
+        if value is not None:
+            argv += [option, str(value)]
+    if args.kinds is not None:
+        argv += ["--kinds", *args.kinds]
+    return main(argv)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Command line; exit 0 if every run was detected, isolated and met its expectations."""
     p = StrictParser(prog="thruster-hil campaign", description=__doc__.split("\n")[0])

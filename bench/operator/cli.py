@@ -364,19 +364,6 @@ def _cmd_inject(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _cmd_campaign(args: argparse.Namespace) -> int:
-    from bench.operator.campaign import main as campaign_main
-
-    argv = [args.scenario, "--out", args.out]
-    for option, value in (("--fault-time", args.fault_time), ("--jobs", args.jobs),
-                          ("--scheduler", args.scheduler)):
-        if value is not None:
-            argv += [option, str(value)]
-    if args.kinds is not None:
-        argv += ["--kinds", *args.kinds]
-    return campaign_main(argv)
-
-
 def _add_timing_parser(sub: Any) -> None:
     from bench.operator.analysis.defaults import (
         DEFAULT_CYCLE_ABS_TOLERANCE_MS,
@@ -483,7 +470,9 @@ def _dispatch(args: argparse.Namespace) -> int:
         if args.command == "monitor":
             return monitor.run(args)
         if args.command == "campaign":
-            return _cmd_campaign(args)
+            from bench.operator.campaign import from_namespace
+
+            return from_namespace(args)
         return _cmd_run(args, alone=args.command == "bench")
     except (ConfigError, BusError, IcdError) as exc:
         print(f"thruster-hil: error: {exc}", file=sys.stderr)

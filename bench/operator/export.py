@@ -125,14 +125,16 @@ def _text(value: float, integer: bool) -> str:
     return str(int(value)) if integer and value == value else format(value, CSV_DIGITS)
 
 
+def _occurring(decoded: Decoded, db: Database) -> list[tuple[Any, _Series]]:
+    """(message, its series) for each DBC message the trace carries, in DBC order."""
+    return [(m, decoded.series[m.name]) for m in db.messages if len(decoded.series[m.name].t_s)]
+
+
 def write_csv(decoded: Decoded, db: Database, folder: Path) -> list[Path]:
     """One CSV per message that occurs (module docstring); returns the paths written."""
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    for m in db.messages:
-        s = decoded.series[m.name]
-        if not len(s.t_s):
-            continue
+    for m, s in _occurring(decoded, db):
         path = folder / f"{m.name}.csv"
         with open(path, "w", newline="", encoding="utf-8") as f:
             w = csv.writer(f)
@@ -178,10 +180,7 @@ def write_parquet(decoded: Decoded, db: Database, folder: Path) -> list[Path]:
         raise ConfigError("command line", "--format", "parquet", PARQUET_HINT) from exc
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    for m in db.messages:
-        s = decoded.series[m.name]
-        if not len(s.t_s):
-            continue
+    for m, s in _occurring(decoded, db):
         fields = [pa.field("t_s", pa.float64(), metadata={"unit": "s"}),
                   pa.field("direction", pa.string())]
         columns: list[Any] = [pa.array(s.t_s, pa.float64()),
