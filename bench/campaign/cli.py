@@ -224,9 +224,14 @@ def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
         raise ConfigError("command line", "CASE", name, f"a case of the campaign folder "
                           f"{campaign_dir} (cannot read {case_dir}/{CASE_FILE} and "
                           f"{RESULT_FILE}: {getattr(exc, 'strerror', None) or exc})") from exc
-    run_dir = out or campaign_dir / "reruns" / name
-    if run_dir.exists():
-        shutil.rmtree(run_dir)
+    if out is None:  # the campaign's own reruns folder: an earlier rerun is replaced
+        run_dir = campaign_dir / "reruns" / name
+        if run_dir.exists():
+            shutil.rmtree(run_dir)
+    elif out.exists() and any(out.iterdir()):
+        raise ConfigError("command line", "--out", str(out), "a new or empty folder")
+    else:
+        run_dir = out
     import subprocess
 
     cmd = [sys.executable, "-m", "bench.operator.cli",

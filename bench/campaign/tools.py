@@ -17,6 +17,7 @@ Exit 2 on bad input, 3 if a run could not complete.
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from pathlib import Path
 
@@ -69,11 +70,22 @@ def _parser() -> StrictParser:
     return p
 
 
+def _new_folder(out: Path) -> Path:
+    """``--out``: a folder that does not exist or is empty (nothing of the user's replaced)."""
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise ConfigError("command line", "--out", str(out), "a new or empty folder")
+    return out
+
+
 def _minimize(args: argparse.Namespace) -> int:
     from bench.campaign.minimize import minimize
 
     d = Path(args.campaign_dir)
-    out = Path(args.out) if args.out else d / "minimal" / args.case
+    if args.out:
+        out = _new_folder(Path(args.out))
+    else:  # the campaign's own folder for it: an earlier search is replaced
+        out = d / "minimal" / args.case
+        shutil.rmtree(out, ignore_errors=True)
     r = minimize(d, args.case, out, args.max_runs)
     if r["minimal"] is None or not r["minimal"]:
         print(f"minimal failure of {args.case}: {r['note']} ({r['runs']} runs)")
@@ -102,7 +114,7 @@ def main(argv: list[str]) -> int:
         from bench.campaign.margin import margin_search
 
         r = margin_search(Path(args.scenario), args.key, args.toward, args.requirement,
-                          Path(args.out), args.tolerance, tuple(args.overrides))
+                          _new_folder(Path(args.out)), args.tolerance, tuple(args.overrides))
     except ConfigError as exc:
         print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

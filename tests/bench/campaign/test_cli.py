@@ -49,3 +49,20 @@ def test_a_folder_holding_something_else_is_refused(
     code = main([str(f), "--out", str(out)])
     assert code == EXIT_BAD_INPUT and "a new or empty folder" in capsys.readouterr().err
     assert (out / "keep.txt").read_text(encoding="utf-8") == "mine"
+
+
+def test_rerun_never_deletes_a_folder_it_did_not_make(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """rerun --out naming a folder with files: exit 2 before any run, the files kept."""
+    from bench.campaign.tools import main as tool_main
+
+    case = tmp_path / "camp" / "cases" / "0001"
+    case.mkdir(parents=True)
+    (case / "case.json").write_text('{"name": "0001"}', encoding="utf-8")
+    (case / "result.json").write_text('{"trace_sha256": null}', encoding="utf-8")
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "keep.txt").write_text("mine", encoding="utf-8")
+    code = tool_main(["rerun", str(tmp_path / "camp"), "0001", "--out", str(out)])
+    assert code == EXIT_BAD_INPUT and "a new or empty folder" in capsys.readouterr().err
+    assert (out / "keep.txt").read_text(encoding="utf-8") == "mine"
