@@ -9,8 +9,7 @@ started in a session of its own and is told to stop (SIGTERM, its run lifecycle 
 ends the pair) if the process that started it dies (Linux ``PR_SET_PDEATHSIG``): a lost
 Dask worker takes its run with it. A run still going after ``timeout_s`` is stopped and
 :class:`CaseTimeoutError` raised (the engine retries once). Exit 2 (a refused input) returns
-a row with status ``"refused"`` (raising would have Dask retry it; the engine stops the
-campaign with :class:`CaseRefusedError` instead).
+a row with status ``"refused"``: not retried (the same input is refused again).
 
 Out: ``cases/NAME/case.json`` (the case: overrides, seed, the command that reproduces it)
 and ``cases/NAME/result.json`` (the row: :func:`result_row`), beside the run folder's
@@ -33,6 +32,7 @@ import uuid
 from pathlib import Path
 from typing import Any
 
+from bench.operator.verdict import abnormal_events
 from bench.results.record import read_lines, run_file
 from dbc.errors import RunError
 from dbc.records import write_record
@@ -47,15 +47,15 @@ RESULT_FILE = "result.json"
 CASE_FILE = "case.json"
 ATTEMPT_MARK = ".attempt-"
 STATUS_OK, STATUS_ERROR, STATUS_REFUSED = "ok", "error", "refused"
+NO_ABNORMAL_EVENT = "no_abnormal_event"
+"""A campaign requirement of every case: nothing abnormal happened beyond the faults asked
+for (:func:`bench.operator.verdict.abnormal_events`: no SAFE latch, deadline miss, watchdog
+trip, restart, rejected frame); a run can meet its expectations and still fail this."""
 STDERR_TAIL_LINES = 5
 
 
 class CaseTimeoutError(RunError):
     """The case's run was still going after its timeout (stopped; retried once)."""
-
-
-class CaseRefusedError(RunError):
-    """The case's run refused its input (exit 2): not retried."""
 
 
 def run_command(scenario: Path, case: dict[str, Any], out: Path) -> list[str]:
@@ -110,6 +110,8 @@ def result_row(case: dict[str, Any], s: dict[str, Any], run_dir: Path,
     figures["detection_time_s"] = (None if failure is None or t_det is None
                                    else round(t_det - case["fault_time_s"], 6))
     reqs = {e["name"]: bool(e["pass"]) for e in s.get("expectations", [])}
+    events = abnormal_events(s)
+    reqs[NO_ABNORMAL_EVENT] = not events
     if failure is not None:
         reqs["failure_isolated"] = (fdir.get("failed_thruster") == failure[1]
                                     and fdir.get("failure_kind") == failure[0])
@@ -118,7 +120,7 @@ def result_row(case: dict[str, Any], s: dict[str, Any], run_dir: Path,
         "seed": case["seed"], "status": STATUS_OK, "error": None,
         "failure": failure, "passed": bool(s.get("passed")) and all(reqs.values()),
         "requirements": reqs, "figures": figures, "values": dict(case["values"]),
-        "abnormal": sorted(s.get("abnormal") or {}),
+        "abnormal": events, "warnings": list(s.get("warnings") or []),
         "trace_sha256": trace_digest(run_dir),
         "wall_time_s": _metric(s, "wall_time_s"), "attempts": attempt,
     }

@@ -10,9 +10,11 @@ progress (cases done, pass rate so far, ETA), then each requirement's pass rate 
 
 The folder: ``campaign.toml`` and ``scenario.toml`` (copies: the campaign reruns from its
 folder alone), ``manifest.json`` (what the cases are: running the same campaign into the
-same folder resumes it; another campaign there is refused), ``cases/NAME/`` per case.
+same folder resumes it, with more cases extends it; another campaign there is refused),
+``cases/NAME/`` per case.
 
-Exit: 0 every case passed; 1 some failed; 2 bad input; 3 a case could not complete.
+Exit: 0 every case passed; 1 some failed; 2 bad input (also a case the flight software
+refused: the others still run); 3 a case could not complete.
 """
 
 from __future__ import annotations
@@ -28,14 +30,14 @@ import time
 from pathlib import Path
 from typing import Any
 
-from bench.campaign.case_run import RESULT_FILE, STATUS_OK, run_command
+from bench.campaign.case_run import RESULT_FILE, STATUS_OK, STATUS_REFUSED, run_command
 from bench.campaign.cases import Case, build_cases
-from bench.campaign.engine import run_cases
+from bench.campaign.engine import done_rows, run_cases
 from bench.campaign.report import write_html, write_tables
 from bench.campaign.spec import CASE_TIMEOUT_BASE_S, CampaignSpec, load_campaign
 from bench.campaign.stats import statistics
 from bench.results.record import read_lines, run_file
-from bench.scenario.load import apply_overrides
+from bench.scenario.load import apply_overrides, override_of
 from bench.scenario.parse import parse_scenario
 from dbc.datafile import parse_toml, read_text
 from dbc.errors import ConfigError, RunError
@@ -73,8 +75,19 @@ def checked_cases(spec: CampaignSpec) -> tuple[str, list[dict[str, Any]], float]
     """The scenario's text, every case (each validated as its run will), the timeout."""
     text = read_text(spec.scenario, "scenario file")
     data = parse_toml(text, str(spec.scenario))
-    apply_overrides(data, list(spec.overrides), f"{spec.source}: campaign.set")
-    sc = parse_scenario(copy.deepcopy(data), str(spec.scenario))
+    if "campaign" in data:
+        raise ConfigError(spec.source, "campaign.scenario", str(spec.scenario),
+                          "a scenario file (this one is a campaign file)")
+    where = f"{spec.source}: campaign.set"
+    apply_overrides(data, list(spec.overrides), where)
+    try:
+        sc = parse_scenario(copy.deepcopy(data), str(spec.scenario))
+    except ConfigError as exc:  # an error the campaign's own overrides caused: name them
+        item = override_of(exc.key, list(spec.overrides))
+        if item is None:
+            raise
+        raise ConfigError(f"{where} {item!r} (on {spec.scenario})", exc.key, exc.value,
+                          exc.expected) from exc
     if spec.failures and not spec.fault_time_s < sc.duration_s:
         raise ConfigError(spec.source, "campaign.fault_time_s", spec.fault_time_s,
                           f"a time before the scenario's end ({sc.duration_s:g} s)")
@@ -88,26 +101,41 @@ def checked_cases(spec: CampaignSpec) -> tuple[str, list[dict[str, Any]], float]
             parse_scenario(d, src)
         except ConfigError as exc:
             raise ConfigError(src, exc.key, exc.value,
-                              f"{exc.expected} (the dispersion drew an impossible case: "
-                              "narrow its distribution)") from exc
+                              f"{exc.expected} (a value a dispersion gave this case: check "
+                              "its distribution)") from exc
     timeout = spec.case_timeout_s or CASE_TIMEOUT_BASE_S + sc.duration_s
     return text, [case_dict(c, spec) for c in cases], timeout
 
 
 def _prepare(out: Path, spec: CampaignSpec, text: str, cases: list[dict[str, Any]]) -> None:
-    digest = hashlib.sha256(json.dumps([text, cases], sort_keys=True).encode()).hexdigest()
+    if out.exists() and not out.is_dir():
+        raise ConfigError("command line", "--out", str(out), "a folder (this is a file)")
+    # what the results depend on: the scenario, which traces are kept, and each case (a
+    # campaign with more or fewer cases of the same draws extends or trims this one)
+    digests = {c["name"]: _sha(json.dumps(c, sort_keys=True)) for c in cases}
+    new: dict[str, Any] = {"scenario_sha256": _sha(text), "keep": spec.keep,
+                           "worst": spec.worst}
     man = out / MANIFEST
     if man.exists():
-        old = json.loads(man.read_text(encoding="utf-8")).get("digest")
-        if old != digest:
+        old = json.loads(man.read_text(encoding="utf-8"))
+        why = next((f"{k} differs" for k in ("scenario_sha256", "keep", "worst")
+                    if old.get(k) != new[k]), None)
+        why = why or next((f"case {n} differs" for n, d in digests.items()
+                           if old.get("cases", {}).get(n, d) != d), None)
+        if why is not None:
             raise ConfigError("command line", "--out", str(out), "an empty folder or this "
-                              "campaign's own (it holds another campaign's cases)")
+                              f"campaign's own (it holds another campaign: {why})")
+        digests = {**old.get("cases", {}), **digests}
     elif out.exists() and any(out.iterdir()):
         raise ConfigError("command line", "--out", str(out), "a new or empty folder")
     out.mkdir(parents=True, exist_ok=True)
     (out / SCENARIO_COPY).write_text(text, encoding="utf-8")
     shutil.copyfile(spec.source, out / CAMPAIGN_COPY)
-    write_record(man, {"digest": digest, "cases": len(cases)})
+    write_record(man, dict(new, cases=digests))
+
+
+def _sha(text: str) -> str:
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 def _decimate(run_dir: Path) -> None:
@@ -154,7 +182,7 @@ def _progress() -> Any:
         passed[0] += bool(row["passed"])
         dt = time.monotonic() - t0
         eta = dt / done * (total - done) if done else 0.0
-        outcome = ("error" if row["status"] != STATUS_OK else
+        outcome = (row["status"] if row["status"] != STATUS_OK else
                    "pass" if row["passed"] else "FAIL")
         line = (f"[{done}/{total}] pass {passed[0]}/{done}, ETA {eta:.0f} s; last "
                 f"{row['name']}: {outcome}")
@@ -164,9 +192,43 @@ def _progress() -> Any:
                 sys.stderr.write("\n")
             sys.stderr.flush()
         else:
-            print(line, flush=True)
+            say(line)
 
     return show
+
+
+def say(line: str, err: bool = False) -> None:
+    """Print a console line; a reader that went away (``| head``) ends the printing, not
+    the campaign (its files are still written)."""
+    stream = sys.stderr if err else sys.stdout
+    try:
+        print(line, file=stream, flush=True)
+    except BrokenPipeError:
+        devnull = open(os.devnull, "w")  # noqa: SIM115 - stands in for the closed stream
+        if err:
+            sys.stderr = devnull
+        else:
+            sys.stdout = devnull
+
+
+def check_fsw_config(sc_path: Path, overrides: list[str], source: str) -> None:
+    """The flight software's own check of the configuration a case gives it
+    (``python -m flight_sw --check``), so a refused ``[flight_sw]`` is bad input before any
+    run starts, not a campaign of refused runs."""
+    import subprocess
+    import tempfile
+
+    from bench.scenario.load import load_scenario
+
+    with tempfile.TemporaryDirectory(prefix="thil-fsw-check-") as tmp:
+        config = Path(tmp) / "fsw_config.json"
+        write_record(config, load_scenario(sc_path, overrides).fsw_config())
+        p = subprocess.run([sys.executable, "-m", "flight_sw", "--config", str(config),
+                            "--check"], capture_output=True, text=True, check=False)
+    if p.returncode != 0:
+        why = (p.stderr.strip().splitlines() or ["(no output)"])[-1]
+        raise ConfigError(source, "flight_sw", "(its configuration)",
+                          f"one the flight software accepts; it said: {why}")
 
 
 def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str | None,
@@ -174,38 +236,56 @@ def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str
     """Run the campaign file at ``path`` into ``out`` (module docstring); the exit code."""
     spec = load_campaign(path)
     text, cases, timeout = checked_cases(spec)
+    check_fsw_config(spec.scenario, list(spec.overrides), spec.source)
     _prepare(out, spec, text, cases)
-    where = scheduler or f"a local Dask cluster of {workers or available_cpus()} workers"
-    print(f"campaign {spec.name}: {len(cases)} cases of {spec.scenario.name} on {where}; "
-          f"folder {out}", flush=True)
+    resumed = len(done_rows(out / "cases", cases))
+    n_workers = min(workers or available_cpus(), max(1, len(cases) - resumed))
+    where = scheduler or f"a local Dask cluster of {n_workers} workers"
+    say(f"campaign {spec.name}: {len(cases)} cases of {spec.scenario.name} on {where}; "
+        f"folder {out}")
+    if resumed:
+        say(f"resuming: {resumed} of {len(cases)} cases already complete in {out}")
     cpu0, t0 = os.times(), time.monotonic()
-    rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, workers, _progress(),
-                     notice=lambda line: print(line, file=sys.stderr, flush=True))
+    rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, n_workers,
+                     _progress(), notice=lambda line: say(line, err=True))
     wall = time.monotonic() - t0
     cpu1 = os.times()
     cpu_s = ((cpu1.children_user - cpu0.children_user)
              + (cpu1.children_system - cpu0.children_system))
+    ran = len(cases) - resumed
+    local = scheduler is None
+    meta: dict[str, Any] = {
+        "name": spec.name, "scenario": spec.scenario.name, "study": spec.study,
+        "seed": spec.seed, "cases": len(cases), "resumed_cases": resumed, "cases_run": ran,
+        "wall_time_s": wall, "cases_per_min": 60.0 * ran / wall if ran and wall > 0 else None,
+        "workers": n_workers if local else None, "scheduler": scheduler,
+        "cpu_s": cpu_s if local else None,
+        "cpu_use": cpu_s / (wall * available_cpus()) if local and ran and wall else None}
     stats = statistics(rows, spec.worst)
-    meta: dict[str, Any] = {"name": spec.name, "scenario": spec.scenario.name, "study": spec.study,
-            "seed": spec.seed, "cases": len(cases), "wall_time_s": wall,
-            "cases_per_min": 60.0 * len(cases) / wall if wall > 0 else None,
-            "workers": None if scheduler else (workers or available_cpus()),
-            "scheduler": scheduler, "cpu_s": cpu_s if scheduler is None else None,
-            "cpu_use": cpu_s / (wall * available_cpus()) if scheduler is None and wall else None}
     stats["pruned"] = prune(out, rows, stats, spec.keep)
     if not write_tables(out, rows, stats, meta):
-        print("campaign.parquet left out: pyarrow is not installed (pip install pyarrow)")
+        say("campaign.parquet left out: pyarrow is not installed (pip install pyarrow)")
     page = write_html(out, rows, stats, meta)
     for name, r in stats["pass_rates"].items():
         rate = "n/a" if r["rate"] is None else f"{r['rate']:.3f}"
-        print(f"  {name}: {r['passes']}/{r['cases']} = {rate}, 95 % interval "
-              f"[{r['ci_low']:.3f}, {r['ci_high']:.3f}]")
+        say(f"  {name}: {r['passes']}/{r['cases']} = {rate}, 95 % interval "
+            f"[{r['ci_low']:.3f}, {r['ci_high']:.3f}]")
+    warned = [r for r in rows if r.get("warnings")]
+    if warned:
+        say(f"  run warnings in {len(warned)} cases, e.g. {warned[0]['name']}: "
+            f"{warned[0]['warnings'][0]}")
+    refused = [r for r in rows if r["status"] == STATUS_REFUSED]
     for r in rows:
         if r["status"] != STATUS_OK:
-            print(f"  ERROR {r['name']}: {r['error']}")
-    use = "" if meta["cpu_use"] is None else f", CPU use {100 * meta['cpu_use']:.0f} %"
-    print(f"campaign: {len(rows)} cases in {wall:.1f} s ({meta['cases_per_min']:.1f} per "
-          f"minute{use}); {stats['errors']} errors; {page}")
+            say(f"  {r['status'].upper()} {r['name']}: {r['error']}")
+    if ran:
+        use = "" if meta["cpu_use"] is None else f", CPU use {100 * meta['cpu_use']:.0f} %"
+        pace = f"{ran} cases run in {wall:.1f} s ({meta['cases_per_min']:.1f} per minute{use})"
+    else:
+        pace = "every case was already complete"
+    say(f"campaign: {len(rows)} cases, {pace}; {stats['errors']} errors; {page}")
+    if refused:  # the flight software refused what a dispersion gave it: bad input
+        return EXIT_BAD_INPUT
     if stats["errors"]:
         return EXIT_RUN_ERROR
     return EXIT_OK if stats["pass_rates"]["passed"]["passes"] == len(rows) else EXIT_FAILED
@@ -236,7 +316,8 @@ def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
 
     cmd = [sys.executable, "-m", "bench.operator.cli",
            *run_command(campaign_dir / SCENARIO_COPY, case, run_dir)]
-    print("rerun: " + case["command"], flush=True)
+    print("rerun: " + " ".join(["thruster-hil", *_quoted(run_command(
+        campaign_dir / SCENARIO_COPY, case, run_dir))]), flush=True)
     p = subprocess.run(cmd, check=False)
     if not (run_dir / "summary.json").exists():
         raise RunError(f"rerun of {name} did not complete (exit {p.returncode})")

@@ -10,8 +10,8 @@ scheduler, a ``distributed.LocalCluster`` of one single-threaded worker process 
 
 - A case that raises (a crash, a timeout) is submitted again once, and ``notice`` says
   so (the console); a case whose worker dies is rescheduled by Dask; after that it is
-  recorded as an error row (``attempts``: how many ran), never dropped. A refused input
-  (exit 2) is not retried: it stops the campaign.
+  recorded as an error row (``attempts``: how many ran), never dropped. A case whose
+  configuration the run refused (exit 2) is not retried: its row says ``refused``.
 - Resume: a case whose ``cases/NAME/result.json`` exists with the same case is not run
   again; stale attempt folders (a lost worker's, an interrupted campaign's) are removed
   before and after.
@@ -27,8 +27,9 @@ import contextlib
 import json
 import logging
 import shutil
+import signal
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -37,20 +38,22 @@ from bench.campaign.case_run import (
     CASE_FILE,
     RESULT_FILE,
     STATUS_OK,
-    STATUS_REFUSED,
-    CaseRefusedError,
     error_row,
     run_case,
 )
+from dbc.errors import ConfigError
 from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
 PROCESSES_PER_CASE = 2  # bench + flight software
+SCHEDULER_TIMEOUT_S = 30.0  # connecting to --scheduler
 RETRIES = 1
-DASK_LOG_LEVEL = logging.ERROR  # Dask's own INFO lines would bury the progress
+DASK_LOG_LEVEL = logging.CRITICAL
+"""Dask's own log lines (a failed task's traceback at ERROR) would bury the progress; the
+engine says itself what failed and what is retried."""
 Progress = Callable[[int, int, dict[str, Any]], None]
 
 
-def _done_rows(cases_dir: Path, cases: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
+def done_rows(cases_dir: Path, cases: list[dict[str, Any]]) -> dict[int, dict[str, Any]]:
     """Rows of cases already complete in ``cases_dir`` (same case), by index."""
     out = {}
     for c in cases:
@@ -72,6 +75,25 @@ def _clear_attempts(cases_dir: Path) -> None:
                 shutil.rmtree(d, ignore_errors=True)
 
 
+@contextlib.contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def _connect(client_cls: Any, scheduler: str) -> Any:
+    """A client of the scheduler at ``scheduler``, or a ConfigError saying why not."""
+    try:
+        return client_cls(scheduler, timeout=SCHEDULER_TIMEOUT_S)
+    except (OSError, ValueError, TypeError) as exc:  # bad address, nothing listening, timeout
+        raise ConfigError("command line", "--scheduler", scheduler,
+                          "the address of a running Dask scheduler, tcp://HOST:PORT (as "
+                          f"`python -m dask scheduler` prints it): {exc}") from exc
+
+
 def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s: float,
               scheduler: str | None = None, workers: int | None = None,
               progress: Progress | None = None,
@@ -82,7 +104,7 @@ def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s:
     cases_dir = out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     _clear_attempts(cases_dir)
-    rows = _done_rows(cases_dir, cases)
+    rows = done_rows(cases_dir, cases)
     total = len(cases)
     for n, i in enumerate(sorted(rows), start=1):
         if progress is not None:
@@ -97,12 +119,16 @@ def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s:
         env[LOCKSTEP_SPIN_ENV] = "0"
     with contextlib.ExitStack() as stack:
         if scheduler is None:
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=min(n_workers, len(todo)), threads_per_worker=1, processes=True,
-                dashboard_address=None, silence_logs=DASK_LOG_LEVEL))
+            # Ctrl-C reaches the terminal's whole process group: the workers ignore it (an
+            # ignored signal stays ignored in the processes they start) and this process
+            # stops them; each case's run is in a session of its own
+            with _sigint_ignored():
+                cluster = stack.enter_context(LocalCluster(
+                    n_workers=min(n_workers, len(todo)), threads_per_worker=1,
+                    processes=True, dashboard_address=None, silence_logs=DASK_LOG_LEVEL))
             client = stack.enter_context(Client(cluster))
         else:
-            client = stack.enter_context(Client(scheduler))
+            client = stack.enter_context(_connect(Client, scheduler))
         token = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
 
         def submit(c: dict[str, Any], attempt: int) -> Any:
@@ -127,8 +153,6 @@ def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s:
                         pending.add(nxt)
                         continue
                     row = error_row(c, f"{why} (after {attempt} attempts)", attempt)
-                if row["status"] == STATUS_REFUSED:  # every case would be: stop here
-                    raise CaseRefusedError(row["error"])
                 rows[c["index"]] = row
                 done += 1
                 if progress is not None:

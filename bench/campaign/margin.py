@@ -76,13 +76,26 @@ def margin_search(scenario: Path, key: str, toward: float, requirement: str, out
     if not tol > 0.0:
         raise ConfigError("command line", "--tolerance", tolerance, "a positive number")
     timeout = CASE_TIMEOUT_BASE_S + sc.duration_s
+
+    def case_at(value: float) -> Any:
+        s = replace(spec, dispersions=(replace(spec.dispersions[0], dist=Sweep((value,))),))
+        (c,) = build_cases(s, data, len(sc.thrusters), sc.seed)
+        return c
+
+    checked = parse_toml(text, str(scenario))  # --toward as the runs will read it
+    apply_overrides(checked, list(case_at(toward).overrides), "command line --set")
+    try:
+        parse_scenario(checked, "command line")
+    except ConfigError as exc:
+        raise ConfigError("command line", "--toward", toward, f"a value the scenario takes "
+                          f"at {key} ({exc.key}: {exc.expected})") from exc
     out.mkdir(parents=True, exist_ok=True)
     (out / "scenario.toml").write_text(text, encoding="utf-8")
     steps: list[dict[str, Any]] = []
+    failed_at_nominal: list[str] = []
 
     def passes(value: float) -> bool:
-        s = replace(spec, dispersions=(replace(spec.dispersions[0], dist=Sweep((value,))),))
-        (c,) = build_cases(s, data, len(sc.thrusters), sc.seed)
+        c = case_at(value)
         case = {"index": len(steps), "name": f"{len(steps):02d}", "vehicle": 0, "seed": c.seed,
                 "overrides": list(c.overrides), "values": [list(v) for v in c.values],
                 "failure": None, "fault_time_s": 0.0}
@@ -94,6 +107,8 @@ def margin_search(scenario: Path, key: str, toward: float, requirement: str, out
             raise ConfigError("command line", "--requirement", requirement,
                               "one of passed, " + ", ".join(reqs))
         ok = row["passed"] if requirement == "passed" else reqs[requirement]
+        if not steps and not ok:
+            failed_at_nominal.extend(k for k, v in reqs.items() if not v)
         steps.append({"value": value, "pass": ok, "figures": row["figures"]})
         print(f"  step {len(steps)}: {key} = {value:.6g}: {'pass' if ok else 'FAIL'}", flush=True)
         return bool(ok)
@@ -102,7 +117,8 @@ def margin_search(scenario: Path, key: str, toward: float, requirement: str, out
                               "key": key, "requirement": requirement,
                               "nominal": nominal, "toward": toward, "tolerance": tol}
     if not passes(nominal):
-        result.update(boundary=None, note="the nominal value fails: no margin")
+        result.update(boundary=None, nominal_fails=True, note="the nominal value fails ("
+                      + (", ".join(failed_at_nominal) or requirement) + "): no margin")
     elif passes(toward):
         result.update(boundary=None, note=f"still passes at {toward:g}: the margin is at "
                       f"least {abs(toward - nominal):g}")

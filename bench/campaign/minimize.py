@@ -79,6 +79,7 @@ def minimize(campaign_dir: Path, name: str, out: Path,
             table.setdefault(last, fill(n))
     timeout = CASE_TIMEOUT_BASE_S + sc.duration_s
     trials: list[dict[str, Any]] = []
+    result: dict[str, Any] = {}
     known: dict[frozenset[str], bool] = {}  # a set already run is not run again
 
     def fails(chosen: dict[str, Any]) -> bool:
@@ -86,20 +87,23 @@ def minimize(campaign_dir: Path, name: str, out: Path,
         if key in known:
             return known[key]
         if len(trials) >= max_runs:
+            write_record(out / "minimal.json", dict(result, minimal=None, partial=True,
+                                                    runs=len(trials), trials=trials))
             raise RunError(f"minimal failure of {name}: more than {max_runs} runs needed "
-                           "(--max-runs)")
+                           f"(--max-runs); the trials so far are in {out / 'minimal.json'}")
         c = dict(case, index=len(trials), name=f"{len(trials):02d}",
                  overrides=kept + _overrides(base, chosen))
         row = run_case(c, str(scenario), str(out / "trials"), timeout, {})
         if row["status"] != STATUS_OK:
             raise RunError(f"minimal failure of {name}, trial {len(trials)}: {row['error']}")
-        trials.append({"nominal": sorted(set(values) - set(chosen)), "passed": row["passed"]})
+        trials.append({"folder": f"trials/{c['name']}",
+                       "nominal": sorted(set(values) - set(chosen)),
+                       "passed": row["passed"], "requirements": row["requirements"]})
         known[key] = not row["passed"]
         return known[key]
 
     out.mkdir(parents=True, exist_ok=True)
-    result: dict[str, Any] = {"campaign": str(campaign_dir), "case": name,
-                              "dispersed": len(values)}
+    result.update(campaign=str(campaign_dir), case=name, dispersed=len(values))
     if not fails(values):
         result.update(minimal=None, note="the case passes as drawn: nothing to minimise")
     elif fails({}):

@@ -31,6 +31,8 @@ DPI = 90
 HIST_BINS = 20
 FIGURE_SIZE_IN = (4.2, 3.0)
 SHOWN_SENSITIVITIES = 5
+VALUES_SHOWN_CHARS = 300
+"""Characters of a worst case's dispersed values in the report's table."""
 """Dispersed keys listed per figure in the sensitivity table (largest |rho| first)."""
 
 
@@ -54,7 +56,7 @@ def _flat(r: dict[str, Any]) -> dict[str, Any]:
            "passed": r["passed"], "trace_sha256": r["trace_sha256"],
            "wall_time_s": r["wall_time_s"], "attempts": r.get("attempts"),
            "error": r["error"],
-           "run_dir": f"cases/{r['name']}/run"}
+           "run_dir": f"cases/{r['name']}/run" if r["status"] == "ok" else None}
     out.update({f"req:{k}": v for k, v in r["requirements"].items()})
     out.update(r["figures"])
     out.update({f"value:{k}": v for k, v in r["values"].items()})
@@ -77,7 +79,21 @@ def write_tables(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any],
         import pyarrow.parquet as pq
     except ImportError:
         return False
-    table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in flat])
+    kinds = {"case": pa.int64(), "vehicle": pa.int64(), "seed": pa.uint64(),
+             "failure_thruster": pa.int64(), "attempts": pa.int64(), "passed": pa.bool_(),
+             "wall_time_s": pa.float64()}
+    kinds.update({m: pa.float64() for m in METRICS})
+    fields = []
+    for c in columns:  # fixed types, so that every campaign's file has the same schema
+        kind = kinds.get(c) or (pa.bool_() if c.startswith("req:") else None)
+        if kind is None and not c.startswith("value:"):
+            kind = pa.string()
+        if kind is None:  # a dispersed value: its type, float64 when no case has it
+            kind = pa.array([r.get(c) for r in flat]).type
+            kind = pa.float64() if pa.types.is_null(kind) else kind
+        fields.append(pa.field(c, kind))
+    table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in flat],
+                                 schema=pa.schema(fields))
     pq.write_table(table, out / "campaign.parquet")
     return True
 
@@ -121,8 +137,16 @@ def _figures(rows: list[dict[str, Any]], stats: dict[str, Any]) -> list[Raw]:
     return imgs
 
 
+def _values_text(values: dict[str, Any]) -> str:
+    """A case's dispersed values, short (the full list is in campaign.csv)."""
+    text = ", ".join(f"{a}={b:.4g}" if isinstance(b, float) else f"{a}={b}"
+                     for a, b in values.items())
+    return text if len(text) <= VALUES_SHOWN_CHARS else (
+        text[:VALUES_SHOWN_CHARS].rsplit(", ", 1)[0] + ", ... (all in campaign.csv)")
+
+
 def _link(name: str) -> Raw:
-    href = html.escape(f"cases/{name}/run/", quote=True)
+    href = html.escape(f"cases/{name}/run/report.html", quote=True)
     return Raw(f"<a href='{href}'>{html.escape(name)}</a>")
 
 
@@ -132,16 +156,15 @@ def write_html(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any],
     pr = stats["pass_rates"]
     rates = [[k, v["passes"], v["cases"], "n/a" if v["rate"] is None else f"{v['rate']:.3f}",
               f"[{v['ci_low']:.3f}, {v['ci_high']:.3f}]"] for k, v in pr.items()]
-    pct = [[k, *(f"{v[f'p{p}']:.4g}" for p in (5, 50, 95, 99)), f"{v['max']:.4g}", v["n"]]
-           for k, v in stats["percentiles"].items()]
+    pct = [[k, *(f"{v[f'p{p}']:.4g}" for p in (5, 50, 95, 99)), f"{v['max']:.4g}", v["n"],
+            v["missing"] or ""] for k, v in stats["percentiles"].items()]
     sens = [[k, ", ".join(f"{key} {s['rho']:+.2f} (p {s['p']:.2g})" for key, s in
                           list(v.items())[:SHOWN_SENSITIVITIES]) or "none"]
             for k, v in stats["sensitivity"].items()]
-    worst = [[k, _link(w["name"]), f"{w['value']:.4g}", w["seed"],
-              ", ".join(f"{a}={b:.4g}" if isinstance(b, float) else f"{a}={b}"
-                        for a, b in w["values"].items())[:300]]
+    worst = [[k, _link(w["name"]), "never" if w["value"] is None else f"{w['value']:.4g}",
+              w["seed"], _values_text(w["values"])]
              for k, ws in stats["worst"].items() for w in ws]
-    errors = [[_link(r["name"]), r["error"]] for r in rows if r["status"] != "ok"]
+    errors = [[r["name"], r["status"], r["error"]] for r in rows if r["status"] != "ok"]
     imgs = "".join(_figures(rows, stats))
     body = (
         f"<h1>Campaign {html.escape(str(meta['name']))}: {stats['completed']} of "
@@ -153,14 +176,16 @@ def write_html(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any],
         "<h2>Requirements (95 % Wilson interval)</h2>"
         + html_table(["requirement", "passed", "cases", "rate", "95 % interval"], rates)
         + "<h2>Figures</h2>"
-        + html_table(["figure", "p5", "p50", "p95", "p99", "max", "cases"], pct)
+        + html_table(["figure", "p5", "p50", "p95", "p99", "max", "cases",
+                      "never reached"], pct)
         + f"<div>{imgs}</div><h2>Sensitivity (Spearman rank correlation)</h2><p>With few "
         "cases and many dispersed keys some correlations are large by chance: read those "
         f"with p above {SIGNIFICANCE:g} as noise.</p>"
         + html_table(["figure", "most sensitive dispersed keys"], sens)
         + "<h2>Worst cases</h2>"
         + html_table(["figure", "case", "value", "seed", "dispersed values"], worst)
-        + ("<h2>Errors</h2>" + html_table(["case", "error"], errors) if errors else ""))
+        + ("<h2>Cases that did not complete</h2>"
+           + html_table(["case", "status", "why"], errors) if errors else ""))
     path = out / "campaign.html"
     path.write_text("<!DOCTYPE html><html><head><meta charset='utf-8'><title>campaign"
                     f"</title><style>{STYLE}</style></head><body>{body}</body></html>\n",

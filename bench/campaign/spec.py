@@ -19,11 +19,12 @@ apply = "value"                   # value (default) | offset (nominal + x) | sca
 
 Optional in ``[campaign]``: ``set`` (``["KEY=VALUE", ...]``: overrides of the scenario
 for every case, e.g. ``"scenario.duration_s=20"``), ``name`` (default: the file's stem),
-``vary_seed`` (default
-true: each vehicle's run seed drawn from the campaign seed; false: the scenario's seed
-for every case), ``case_timeout_s`` (a case still running after this is killed, retried
-once, then recorded as an error), ``worst`` (cases listed as worst per metric, traces
-kept), ``keep`` (``"failing"``: full traces only for failing and worst cases; ``"all"``).
+``vary_seed`` (true: each vehicle's run seed drawn from the campaign seed; false: the
+scenario's seed for every case, so that a factorial study's factors are not mixed with
+sensor noise; default true for a Monte Carlo, false for a factorial study),
+``case_timeout_s`` (a case still running after this is killed, retried once, then
+recorded as an error), ``worst`` (cases listed as worst per figure, traces kept), ``keep``
+(``"failing"``: full traces only for failing and worst cases; ``"all"``).
 Every error names the file and the key.
 """
 
@@ -115,10 +116,19 @@ class CampaignSpec:
 
     def __post_init__(self) -> None:
         if self.study == "factorial":
-            for d in self.dispersions:
+            for i, d in enumerate(self.dispersions):
                 if not d.dist.levels():
-                    raise ConfigError(self.source, f"dispersions.{d.key}.dist", "continuous",
+                    raise ConfigError(self.source, f"dispersions[{i}].dist",
+                                      type(d.dist).__name__.lower(),
                                       "a sweep or a choice in a factorial study")
+
+
+def _near(word: object, choices: Any) -> str:
+    """`` (did you mean X?)`` for a near miss among ``choices``, else nothing."""
+    import difflib
+
+    near = difflib.get_close_matches(str(word), sorted(choices), n=1)
+    return f" (did you mean {near[0]!r}?)" if near else ""
 
 
 def _dispersion(source: str, i: int, t: object) -> Dispersion:
@@ -134,8 +144,8 @@ def _dispersion(source: str, i: int, t: object) -> Dispersion:
         raise ConfigError(source, where, sorted(t), "exactly one of name (an alias) or key")
     if "name" in t:
         if t["name"] not in ALIASES:
-            raise ConfigError(source, f"{where}.name", t["name"],
-                              "one of " + ", ".join(sorted(ALIASES)))
+            raise ConfigError(source, f"{where}.name", t["name"], "one of "
+                              + ", ".join(sorted(ALIASES)) + _near(t["name"], ALIASES))
         key = ALIASES[t["name"]]
     else:
         key = t["key"]
@@ -159,8 +169,8 @@ def parse_campaign(data: dict[str, Any], source: str, base: Path) -> CampaignSpe
              "fault_time_s", "case_timeout_s", "worst", "keep", "set"}
     if set(c) - known:
         bad = sorted(set(c) - known)[0]
-        raise ConfigError(source, f"campaign.{bad}", c[bad],
-                          "no such key (" + ", ".join(sorted(known)) + ")")
+        raise ConfigError(source, f"campaign.{bad}", c[bad], "no such key ("
+                          + ", ".join(sorted(known)) + ")" + _near(bad, known))
     sc = c.get("scenario")
     if not isinstance(sc, str) or not sc:
         raise ConfigError(source, "campaign.scenario", sc, "a scenario file path")
@@ -174,6 +184,12 @@ def parse_campaign(data: dict[str, Any], source: str, base: Path) -> CampaignSpe
     keep = c.get("keep", "failing")
     if keep not in KEEP:
         raise ConfigError(source, "campaign.keep", keep, "one of " + ", ".join(KEEP))
+    if study == "factorial" and "cases" in c:
+        raise ConfigError(source, "campaign.cases", c["cases"], "absent in a factorial study "
+                          "(its cases are every combination of the sweeps)")
+    if "fault_time_s" in c and not failures:
+        raise ConfigError(source, "campaign.fault_time_s", c["fault_time_s"], "absent "
+                          "without failures (it is when each injected failure starts)")
     timeout = c.get("case_timeout_s")
     sets = c.get("set", [])
     if not isinstance(sets, list) or not all(isinstance(x, str) and "=" in x for x in sets):
@@ -188,7 +204,8 @@ def parse_campaign(data: dict[str, Any], source: str, base: Path) -> CampaignSpe
         study=study,
         cases=check.integer(source, "campaign.cases", c.get("cases", 1), 1, MAX_CASES),
         seed=check.integer(source, "campaign.seed", c.get("seed", 0), 0, SEED_MAX),
-        vary_seed=check.flag(source, "campaign.vary_seed", c.get("vary_seed", True)),
+        vary_seed=check.flag(source, "campaign.vary_seed",
+                             c.get("vary_seed", study == "monte_carlo")),
         failures=tuple(dict.fromkeys(failures)),
         fault_time_s=check.number(source, "campaign.fault_time_s",
                                   c.get("fault_time_s", DEFAULT_FAULT_TIME_S), 0.0),

@@ -13,6 +13,9 @@ cases, sensitivities. Pure (rows in, dicts out).
   two-sided p-value: with few cases and many dispersed keys, some correlations are large
   by chance (read those with p above :data:`SIGNIFICANCE` as noise).
 Cases recorded as errors are counted (``errors``) and left out of every rate and figure.
+A settling time a case never reached (:data:`WORST_WHEN_MISSING`) is counted as
+``missing`` beside its percentiles, and such cases head its worst list (value None): a
+campaign whose slowest cases never settled must not look fast.
 """
 
 from __future__ import annotations
@@ -27,6 +30,8 @@ Z_95 = 1.959963984540054
 """Standard normal quantile of (1 + CONFIDENCE)/2."""
 PERCENTILES = (5, 50, 95, 99)
 MIN_SENSITIVITY_CASES = 3
+WORST_WHEN_MISSING = ("settling_time_s",)
+"""Figures whose absence in a completed case means the worst outcome (never settled)."""
 SIGNIFICANCE = 0.05
 """A rank correlation needs at least this many cases with both values."""
 
@@ -72,13 +77,22 @@ def _figure_columns(rows: list[dict[str, Any]]) -> dict[str, list[tuple[int, flo
     return cols
 
 
+def _missing(rows: list[dict[str, Any]], figure: str) -> list[dict[str, Any]]:
+    """Completed cases without ``figure`` where that means the worst (never settled)."""
+    if figure not in WORST_WHEN_MISSING:
+        return []
+    return [r for r in _ok(rows) if r["figures"].get(figure) is None]
+
+
 def percentiles(rows: list[dict[str, Any]]) -> dict[str, dict[str, float]]:
-    """Per figure: its percentiles, minimum, maximum, mean and count."""
+    """Per figure: its percentiles, minimum, maximum, mean and count over the cases that
+    have it, and ``missing``: cases that never reached it (module docstring)."""
     out = {}
     for k, pairs in _figure_columns(rows).items():
         x = np.array([v for _, v in pairs])
         d = {f"p{p}": float(np.percentile(x, p)) for p in PERCENTILES}
-        d.update(min=float(x.min()), max=float(x.max()), mean=float(x.mean()), n=len(x))
+        d.update(min=float(x.min()), max=float(x.max()), mean=float(x.mean()), n=len(x),
+                 missing=len(_missing(rows, k)))
         out[k] = d
     return out
 
@@ -88,7 +102,8 @@ def worst_cases(rows: list[dict[str, Any]], count: int) -> dict[str, list[dict[s
     by_case = {r["case"]: r for r in rows}
     out = {}
     for k, pairs in _figure_columns(rows).items():
-        top = sorted(pairs, key=lambda p: (-p[1], p[0]))[:count]
+        never: list[tuple[int, float | None]] = [(r["case"], None) for r in _missing(rows, k)]
+        top = (never + sorted(pairs, key=lambda p: (-p[1], p[0])))[:count]
         out[k] = [{"case": i, "name": by_case[i]["name"], "value": v,
                    "seed": by_case[i]["seed"], "values": by_case[i]["values"]}
                   for i, v in top]

@@ -11,7 +11,9 @@ a requirement's margin on one key.
   [--tolerance T] [--set KEY=VALUE ...]``: bisection from the scenario's value toward a failing one
   (:mod:`bench.campaign.margin`); prints the boundary, its uncertainty, the margin and
   the number of runs.
-Exit 2 on bad input, 3 if a run could not complete.
+Exit codes: rerun 0 identical, 1 different; margin 0 a margin or a lower bound found, 1
+the scenario fails at its own value; minimize 0; all: 2 bad input, 3 a run could not
+complete.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from dbc import options as opt
 from dbc.errors import ConfigError, RunError
 from dbc.options import StrictParser
 
-EXIT_BAD_INPUT, EXIT_RUN_ERROR = 2, 3
+EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 1, 2, 3
 MAX_MINIMIZE_RUNS = 10_000
 
 
@@ -123,9 +125,12 @@ def main(argv: list[str]) -> int:
         return EXIT_RUN_ERROR
     if r.get("boundary") is None:
         print(f"margin of {r['key']} for {r['requirement']}: {r['note']} ({r['runs']} runs)")
+        if r.get("nominal_fails"):
+            return EXIT_FAILED
     else:
         rel = "" if r["margin_relative"] is None else f" ({100 * r['margin_relative']:+.1f} %)"
         print(f"margin of {r['key']} for {r['requirement']}: fails from {r['boundary']:.6g} "
-              f"± {r['uncertainty']:.2g} (nominal {r['nominal']:g}): margin "
+              f"± {r['uncertainty']:.2g} (last pass {r['last_pass']:.6g}, first fail "
+              f"{r['first_fail']:.6g}; nominal {r['nominal']:g}): margin "
               f"{r['margin']:+.6g}{rel}; {r['runs']} runs; {Path(args.out) / 'margin.json'}")
     return 0

@@ -16,7 +16,8 @@ and units). Out, ``thruster-hil export RUN_DIR --format ...``:
 - ``parquet``: a folder with one Apache Parquet file per message that occurs (pyarrow, the
   optional extra ``[parquet]``): columns ``t_s`` (float64), ``direction`` (string) and one
   per signal named as in the DBC, int64 for integer signals, float64 for the others, the
-  DBC's unit in each column's field metadata (``unit``) and the message's name and ID in
+  DBC's unit in each column's field metadata (``unit``; an enumeration's value table as
+  JSON in ``choices``) and the message's name and ID in
   the file's metadata: for pandas (``pandas.read_parquet``), polars, DuckDB or Spark.
 
 A trace with no frame of the DBC is refused (a ConfigError: not a run's trace).
@@ -31,6 +32,7 @@ from __future__ import annotations
 
 import csv
 import importlib.util
+import json
 from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -187,7 +189,10 @@ def write_parquet(decoded: Decoded, db: Database, folder: Path) -> list[Path]:
                               pa.array(["Rx" if rx else "Tx" for rx in s.rx], pa.string())]
         for sig in m.signals:
             kind = pa.int64() if _is_integer(sig) else pa.float64()
-            fields.append(pa.field(sig.name, kind, metadata={"unit": sig.unit or ""}))
+            meta = {"unit": sig.unit or ""}
+            if sig.choices:  # an enumeration: its names, as the DBC's value table gives them
+                meta["choices"] = json.dumps({int(k): str(v) for k, v in sig.choices.items()})
+            fields.append(pa.field(sig.name, kind, metadata=meta))
             col = pa.array(s.values[sig.name], pa.float64())
             columns.append(col.cast(kind) if kind == pa.int64() else col)
         schema = pa.schema(fields, metadata={"message": m.name, "frame_id": hex(m.frame_id)})

@@ -73,6 +73,13 @@ def _faults(s: dict[str, Any]) -> list[str]:
 
 def abnormal(s: dict[str, Any]) -> list[str]:
     """Every abnormal thing in summary ``s``, one line each (empty for a clean run)."""
+    return abnormal_events(s) + _faults(s)
+
+
+def abnormal_events(s: dict[str, Any]) -> list[str]:
+    """What :func:`abnormal` lists except the faults themselves (those the scenario or an
+    operator asked for) and FDIR's isolation of them: what went wrong on its own, or
+    because of a fault (a SAFE latch, deadline misses, watchdog trips, rejected frames)."""
     out = []
     ended = s.get("ended", "completed")
     if s.get("refused"):
@@ -110,7 +117,6 @@ def abnormal(s: dict[str, Any]) -> list[str]:
     if rejects:
         cut = rejects[:MAX_REJECT_LINES] + (["..."] if len(rejects) > MAX_REJECT_LINES else [])
         out.append("frames rejected: " + "; ".join(cut))
-    out += _faults(s)
     return out
 
 

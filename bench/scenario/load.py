@@ -79,7 +79,7 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     try:
         sc = parse_scenario(data, str(p))
     except ConfigError as exc:
-        item = _override_of(exc.key, overrides or [])
+        item = override_of(exc.key, overrides or [])
         if item is None:
             raise
         raise ConfigError(override_source(str(p), [item]), exc.key, exc.value,
@@ -87,7 +87,7 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scena
     return dataclasses.replace(sc, overrides=tuple(overrides or ()))
 
 
-def _override_of(key: str, overrides: list[str]) -> str | None:
+def override_of(key: str, overrides: list[str]) -> str | None:
     """The ``--set`` item that wrote ``key`` (or a table above or below it), if any."""
     for item in reversed(overrides):  # the last one wins, as applied
         k = item.partition("=")[0]

@@ -200,6 +200,17 @@ def _actual_thrusters(t: Table, geo: list[ThrusterSpec]) -> list[ThrusterSpec]:
     return geo
 
 
+def _response_delay(t: Table, period_s: float) -> float:
+    """``[bus] fsw_response_delay_s``: shorter than one control period, the lockstep
+    protocol's assumption (a cycle's commands are applied before the next SYNC)."""
+    delay = t.number("fsw_response_delay_s", 0.001, lo=0.0)
+    if not delay < period_s:
+        raise t.error("fsw_response_delay_s", delay, f"a delay shorter than the control "
+                      f"period ({period_s:g} s: lockstep applies each cycle's commands before "
+                      "the next SYNC)")
+    return delay
+
+
 def _icd_range(db: Database, message: str, signals: tuple[str, ...]) -> float:
     """The largest symmetric range the DBC's ``signals`` of ``message`` can carry."""
     msg = db.get_message_by_name(message)
@@ -360,7 +371,7 @@ def parse_scenario(data: dict[str, Any], source: str) -> Scenario:
     rate_default, (rate_lo, rate_hi) = bitrate_bps(db), bitrate_range_bps(db)
     bus = BusSpecCfg(
         bitrate_bps=bt.integer("bitrate_bps", rate_default, lo=rate_lo, hi=rate_hi),
-        fsw_response_delay_s=bt.number("fsw_response_delay_s", 0.001, lo=0.0, hi=0.1),
+        fsw_response_delay_s=_response_delay(bt, period_s),
         stall_timeout_s=bt.number("stall_timeout_s", 2.0, lo=0.0, lo_open=True),
         startup_timeout_s=bt.number("startup_timeout_s", 60.0, lo=0.0, lo_open=True),
     )

@@ -22,8 +22,7 @@ def test_campaign_scale_small() -> None:
     """Every section of benchmarks/campaign_scale.py, small: its invariants hold."""
     done = subprocess.run(
         [sys.executable, str(SCRIPT), "--single-runs", "1", "--mc-cases", "4",
-         "--three-way-cases", "4", "--duration", "10", "--latency-toward", "0.1",
-         "--margin-tolerance", "0.02", "0.2"],
+         "--three-way-cases", "4", "--duration", "10", "--margin-tolerance", "0.004", "0.2"],
         cwd=REPO, capture_output=True, text=True, timeout=TIMEOUT_S)
     assert done.returncode == 0, done.stderr[-3000:]
     r = json.loads(done.stdout)
@@ -37,8 +36,9 @@ def test_campaign_scale_small() -> None:
     assert lost["killed_after_cases"] is not None, lost
     assert (lost["exit"], lost["cases"], lost["duplicates"], lost["errors"]) == (0, 4, 0, 0)
     assert lost["attempt_folders_left"] == [] and lost["identical_to_local"]
-    for key, m in r["margins"].items():
-        assert m["boundary"] is not None, (key, m)
-        assert m["runs"] >= 3 and m["uncertainty"] > 0.0
+    for key, m in r["margins"].items():  # a bracketed boundary, or a lower bound on it
         lo, hi = sorted((m["nominal"], m["toward"]))
-        assert lo < m["boundary"] < hi
+        if m["boundary"] is None:
+            assert m["runs"] == 2 and "still passes" in m["note"], (key, m)
+        else:
+            assert m["runs"] >= 3 and m["uncertainty"] > 0.0 and lo < m["boundary"] < hi

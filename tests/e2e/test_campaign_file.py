@@ -56,7 +56,7 @@ def test_small_monte_carlo_reruns_and_resumes(tmp_path: Path, runtime: Path) -> 
     assert table.column("trace_sha256").to_pylist() == [r["trace_sha256"] for r in rows]
     assert "value:thrusters.actual_thrust_scale[7]" in rows[0]
     html = (out / "campaign.html").read_text(encoding="utf-8")
-    assert "href='cases/0000/run/'" in html  # 3 cases: each among the 5 worst, linked
+    assert "href='cases/0000/run/report.html'" in html  # 3 cases: each among the 5 worst
 
     rerun = _hil(["campaign", "rerun", str(out), "0001"], runtime)
     assert rerun.returncode == 0, rerun.stdout[-2000:] + rerun.stderr[-2000:]
@@ -72,16 +72,24 @@ def test_small_monte_carlo_reruns_and_resumes(tmp_path: Path, runtime: Path) -> 
     assert [(r["name"], r["trace_sha256"], r["figures"]) for r in after] == \
         [(r["name"], r["trace_sha256"], r["figures"]) for r in before]
 
+    f.write_text(f.read_text(encoding="utf-8").replace(f"cases = {CASES}",
+                                                       f"cases = {CASES + 1}"), encoding="utf-8")
+    more = _hil(["campaign", str(f), "--out", str(out)], runtime)  # extended by one case
+    assert more.returncode in (0, 1), more.stderr[-3000:]
+    assert f"resuming: {CASES} of {CASES + 1} cases" in more.stdout and "1 cases run" in more.stdout
+    grown = json.loads((out / "campaign.json").read_text(encoding="utf-8"))["cases"]
+    assert [r["trace_sha256"] for r in grown[:CASES]] == [r["trace_sha256"] for r in before]
+
 
 def test_minimal_failure_names_the_dispersion_that_fails(tmp_path: Path, runtime: Path) -> None:
-    """A 90 ms command latency fails the 12 s quickstart, a 0.1 deg/s initial rate does not:
-    the minimal failure keeps the latency alone, the rate back at nominal."""
+    """A 90 ms valve opening delay fails the 12 s quickstart, a 0.1 deg/s initial rate does
+    not: the minimal failure keeps the delay alone, the rate back at nominal."""
     f = tmp_path / "f.toml"
     f.write_text(
         f'[campaign]\nscenario = "{QUICKSTART}"\nstudy = "factorial"\n'
         'set = ["scenario.duration_s=12.0", "expectations.steady_state_window_s=4.0"]\n'
         '[[dispersions]]\nname = "initial_rate"\ndist = "sweep"\nvalues = [0.1]\n'
-        '[[dispersions]]\nname = "latency"\ndist = "sweep"\nvalues = [0.09]\n',
+        '[[dispersions]]\nname = "open_delay"\ndist = "sweep"\nvalues = [0.09]\n',
         encoding="utf-8")
     out = tmp_path / "out"
     run = _hil(["campaign", str(f), "--out", str(out)], runtime)
@@ -89,15 +97,16 @@ def test_minimal_failure_names_the_dispersion_that_fails(tmp_path: Path, runtime
     m = _hil(["campaign", "minimize", str(out), "0000", "--out", str(tmp_path / "m")], runtime)
     assert m.returncode == 0, m.stderr[-2000:]
     r = json.loads((tmp_path / "m" / "minimal.json").read_text(encoding="utf-8"))
-    assert r["minimal"] == {"bus.fsw_response_delay_s": 0.09}, r
-    # as drawn (fails), at nominal (passes), without the rates (fails); without the latency
+    assert r["minimal"] == {"thrusters.open_delay_s": 0.09}, r
+    # as drawn (fails), at nominal (passes), without the rates (fails); without the delay
     # is the nominal case again: not rerun
     assert [t["passed"] for t in r["trials"]] == [False, True, False]
 
 
 def test_an_interrupted_campaign_resumes(tmp_path: Path, runtime: Path) -> None:
-    """Ctrl-C after the first case: the campaign stops (no case folder half-written); the
-    same command again runs only the cases missing and ends with every case once."""
+    """Ctrl-C after the first case (SIGINT to the whole process group, as a terminal sends
+    it): the campaign stops without a traceback (no case folder half-written); the same
+    command again runs only the cases missing and ends with every case once."""
     import os
     import signal
     import time
@@ -113,14 +122,15 @@ def test_an_interrupted_campaign_resumes(tmp_path: Path, runtime: Path) -> None:
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime))
     p = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", "campaign", str(f),
                           "--out", str(out)], env=env, stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
     deadline = time.monotonic() + RUN_TIMEOUT_S
     finished = out / "cases"
     while not (finished.exists() and list(finished.glob("*/result.json"))):
         assert p.poll() is None and time.monotonic() < deadline, "no case finished"
         time.sleep(POLL_S)
-    p.send_signal(signal.SIGINT)
-    p.communicate(timeout=RUN_TIMEOUT_S)
+    os.killpg(p.pid, signal.SIGINT)
+    _, err = p.communicate(timeout=RUN_TIMEOUT_S)
+    assert "Traceback" not in err, err[-3000:]
     done_before = {d.name for d in (out / "cases").glob("*") if (d / "result.json").exists()}
     assert p.returncode != 0 and 1 <= len(done_before) < cases
     assert not (out / "campaign.json").exists()

@@ -27,7 +27,7 @@ def test_an_impossible_draw_is_refused_naming_case_and_key(
     code = main([str(f), "--out", str(tmp_path / "out")])
     err = capsys.readouterr().err
     assert code == EXIT_BAD_INPUT, err
-    assert "case 0000" in err and "inertia_B_kgm2" in err and "narrow its distribution" in err
+    assert "case 0000" in err and "inertia_B_kgm2" in err and "check its distribution" in err
     assert not (tmp_path / "out").exists()
 
 

@@ -45,6 +45,10 @@ def test_every_alias_names_a_key_of_a_scenario_or_a_default() -> None:
      "dispersions[0].apply"),
     ({"scenario": "q.toml"}, [{"name": "mass", "dist": "sweep", "values": [1], "sigma": 1}],
      "dispersions[0].sigma"),
+    ({"scenario": "q.toml", "study": "factorial", "cases": 5}, [], "campaign.cases"),
+    ({"scenario": "q.toml", "fault_time_s": 3.0}, [], "campaign.fault_time_s"),
+    ({"scenario": "q.toml", "study": "factorial"},
+     [{"name": "mass", "dist": "normal", "mean": 0, "sigma": 1}], "dispersions[0].dist"),
 ])
 def test_bad_campaigns_name_the_key(campaign: dict[str, Any], dispersions: list[Any],
                                     key: str) -> None:

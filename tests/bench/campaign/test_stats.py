@@ -12,6 +12,7 @@ from bench.campaign.stats import (
     SIGNIFICANCE,
     Z_95,
     pass_rates,
+    percentiles,
     sensitivities,
     wilson_interval,
     worst_cases,
@@ -66,6 +67,18 @@ def test_worst_cases_largest_first_with_seeds() -> None:
     rows = [_row(i, True, v, i) for i, v in enumerate([3.0, 9.0, 1.0, 7.0])]
     w = worst_cases(rows, 2)["f"]
     assert [(x["case"], x["value"], x["seed"]) for x in w] == [(1, 9.0, 1), (3, 7.0, 3)]
+
+
+def test_a_case_that_never_settled_heads_the_worst_and_is_counted() -> None:
+    """Settling None (never settled) is the worst, not left out: first in the worst list,
+    counted as missing beside percentiles taken over the cases that settled."""
+    rows = [_row(i, True, 0.0, float(i)) for i in range(3)]
+    for r, t in zip(rows, (5.0, None, 6.0), strict=True):
+        r["figures"] = {"settling_time_s": t}
+    w = worst_cases(rows, 2)["settling_time_s"]
+    assert [(x["case"], x["value"]) for x in w] == [(1, None), (2, 6.0)]
+    p = percentiles(rows)["settling_time_s"]
+    assert (p["n"], p["missing"], p["max"]) == (2, 1, 6.0)
 
 
 def test_rank_correlation_of_monotone_and_reversed_data() -> None:

@@ -276,12 +276,13 @@ ROWS: list[Row] = [
        "ted one of accel_bias, bitrate, close_delay, com_offset, fault_target, fault_tim"
        "e, gyro_bias, gyro_noise, inertia_xx, inertia_yy, inertia_zz, initial_attitude, "
        "initial_position, initial_rate, initial_velocity, isp, latency, mass, min_on_tim"
-       "e, misalignment, open_delay, star_tracker_noise, thrust_scale"),
+       "e, misalignment, open_delay, star_tracker_noise, thrust_scale (did you mean 'mas"
+       "s'?)"),
     _r(HIL, "campaign impossible.toml --out c",
        "thruster-hil campaign: error: impossible.toml: case 0000: vehicle.inertia_B_kgm2"
        " = [[159.5, 0.0, 0.0], [0.0, 72.19, 0.0], [0.0, 0.0, 72.19]]: expected principal"
-       " moments obeying the triangle inequality (a physical body) (the dispersion drew "
-       "an impossible case: narrow its distribution)"),
+       " moments obeying the triangle inequality (a physical body) (a value a dispersion"
+       " gave this case: check its distribution)"),
     _r(HIL, "campaign impossible.toml --out c --kinds stuck_open",
        "thruster-hil campaign: error: command line: --kinds = ['stuck_open']: expected a"
        "bsent with a campaign file (its [campaign] table says fault_time_s and failures)"),
