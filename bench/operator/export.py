@@ -79,7 +79,9 @@ def decode_trace(run_dir: Path, db: Database) -> Decoded:
         raise ConfigError("command line", "RUN_DIR", str(run_dir), "an existing run folder")
     path = run_file(run_dir, "trace.asc")
     if not path.exists():
-        raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace")
+        raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace "
+                          "(a campaign keeps it for failing and worst cases only: `thruster-hil "
+                          "campaign rerun DIR CASE` makes the run again, trace included)")
     by_id = {m.frame_id: m for m in db.messages}
     out = Decoded({m.name: _Series(values={s.name: array(FLOAT64) for s in m.signals})
                    for m in db.messages})

@@ -80,7 +80,9 @@ def split_cycles(run_dir: Path, db: Database) -> tuple[list[can.Message], list[_
     """The bench's frames before the first SYNC, and the recording cycle by cycle."""
     path = run_file(run_dir, "trace.asc")
     if not path.exists():
-        raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace")
+        raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace "
+                          "(a campaign keeps it for failing and worst cases only: `thruster-hil "
+                          "campaign rerun DIR CASE` makes the run again, trace included)")
     icd = Icd.from_database(db)
     names = {m.frame_id: m.name for m in db.messages}
     before: list[can.Message] = []

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from bench.operator.verdict import MAX_REJECT_LINES, abnormal, verdict
+from bench.operator.verdict import MAX_REJECT_LINES, abnormal, abnormal_events, verdict
 
 
 def _clean(**changes: Any) -> dict[str, Any]:
@@ -91,6 +91,15 @@ def test_faults_and_their_isolation_are_listed() -> None:
         "fault stuck_open thruster 2 at 5.00 s",
         "fault drop message IMU_RATE at 8.00 s (FAULT_CMD) NOT APPLIED: lockstep only",
         "FDIR isolated thruster 2 (stuck_open) detected at 5.3 s"]
+
+
+def test_abnormal_events_leave_out_the_faults_asked_for_not_what_they_caused() -> None:
+    """An injected fault and its isolation are not events; the SAFE latch it caused is."""
+    s = _clean(faults=[{"kind": "stuck_open", "thruster": 2, "t_s": 5.0, "source": "scenario"}],
+               fdir={"failed_thruster": 2, "failure_kind": "stuck_open", "detection_time_s": 5.3})
+    assert abnormal_events(s) == [] and len(abnormal(s)) == 2
+    s["fsw"] = {"exit_code": 0, "mode": "SAFE"}
+    assert abnormal_events(s) == ["flight software ended in mode SAFE"]
 
 
 def test_failures_are_named_in_the_verdict() -> None:
