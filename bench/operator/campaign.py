@@ -107,7 +107,7 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
         return _row(k, kind, s, r["figures"]["detection_time_s"], run_dir)
 
     def show(done: int, total: int, r: dict[str, Any]) -> None:
-        if progress is not None:
+        if progress is not None and r["status"] == "ok":  # the others: an error below
             progress(done, total, row_of(r))
 
     results = run_cases(cases, out / SCENARIO_COPY, out, CASE_TIMEOUT_BASE_S + sc.duration_s,
