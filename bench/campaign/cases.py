@@ -28,7 +28,16 @@ from typing import Any
 import numpy as np
 
 from bench.campaign.distributions import Value
-from bench.campaign.paths import Part, expand, get_value, leaf_key, path_text, set_value, toml_value
+from bench.campaign.paths import (
+    Part,
+    expand,
+    get_value,
+    leaf_key,
+    leaf_path,
+    path_text,
+    set_value,
+    toml_value,
+)
 from bench.campaign.spec import CampaignSpec, Dispersion
 from bench.scenario.limits import SEED_MAX
 from dbc.errors import ConfigError
@@ -70,19 +79,20 @@ ABSENT_DEFAULTS: dict[str, Callable[[int], Any]] = {
 MASS_KEYS = ("vehicle.mass_kg", "vehicle.inertia_B_kgm2")
 
 
-def with_defaults(spec: CampaignSpec, data: dict[str, Any], n_thrusters: int) -> dict[str, Any]:
-    """A copy of scenario ``data`` with every dispersed key that it leaves out set to its
-    nominal value (:data:`ABSENT_DEFAULTS`)."""
+def with_defaults(keys: list[tuple[Part, ...]], data: dict[str, Any],
+                  n_thrusters: int) -> dict[str, Any]:
+    """A copy of scenario ``data`` with every dispersed key of ``keys`` (parsed by
+    :func:`~bench.campaign.paths.parse_key`) that it leaves out set to its nominal value
+    (:data:`ABSENT_DEFAULTS`)."""
     out = copy.deepcopy(data)
-    for d in spec.dispersions:
-        leaf = leaf_key(tuple((n, ()) for n, _ in d.parts))
-        fill = ABSENT_DEFAULTS.get(leaf)
+    for parts in keys:
+        fill = ABSENT_DEFAULTS.get(leaf_key(tuple((n, ()) for n, _ in parts)))
         if fill is None:
             continue
         table: dict[str, Any] = out
-        for name, _ in d.parts[:-1]:
+        for name, _ in parts[:-1]:
             table = table.setdefault(name, {})
-        table.setdefault(d.parts[-1][0], fill(n_thrusters))
+        table.setdefault(parts[-1][0], fill(n_thrusters))
     return out
 
 
@@ -137,7 +147,7 @@ def build_cases(spec: CampaignSpec, data: dict[str, Any], n_thrusters: int,
                 scenario_seed: int) -> list[Case]:
     """Every case of the campaign on scenario ``data`` (module docstring; ``data`` with the
     campaign's own overrides already applied)."""
-    base = with_defaults(spec, data, n_thrusters)
+    base = with_defaults([d.parts for d in spec.dispersions], data, n_thrusters)
     targets = _targets(spec, base)
     pin_nominal = "nominal" not in base.get("vehicle", {}) and any(
         leaf_key(p).startswith(MASS_KEYS) for t in targets for p in t)
@@ -153,7 +163,7 @@ def build_cases(spec: CampaignSpec, data: dict[str, Any], n_thrusters: int,
                 values.append((path_text(p), v))
                 leaves.setdefault(leaf_key(p), p)
         overrides = [*spec.overrides] + [
-            f"{k}={toml_value(get_value(applied, _leaf_path(p)))}" for k, p in leaves.items()]
+            f"{k}={toml_value(get_value(applied, leaf_path(p)))}" for k, p in leaves.items()]
         if pin_nominal:
             v = base["vehicle"]
             overrides.append("vehicle.nominal=" + toml_value(
@@ -174,6 +184,3 @@ def build_cases(spec: CampaignSpec, data: dict[str, Any], n_thrusters: int,
                                   (*ov, f"faults={toml_value(faults)}"), vals, (kind, k)))
     return cases
 
-
-def _leaf_path(p: tuple[Part, ...]) -> tuple[Part, ...]:
-    return (*p[:-1], (p[-1][0], ()))

@@ -24,6 +24,7 @@ import gzip
 import hashlib
 import json
 import os
+import shlex
 import shutil
 import sys
 import time
@@ -66,9 +67,24 @@ def case_dict(c: Case, spec: CampaignSpec) -> dict[str, Any]:
 
 
 def _quoted(args: list[str]) -> list[str]:
-    import shlex
-
     return [shlex.quote(a) for a in args]
+
+
+def new_folder(out: Path) -> Path:
+    """``--out``: a folder that does not exist or is empty (nothing of the user's replaced)."""
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise ConfigError("command line", "--out", str(out), "a new or empty folder")
+    return out
+
+
+def error_exit(exc: ConfigError | RunError) -> int:
+    """The campaign commands' one line for a refused input (exit 2) or a run that could not
+    complete (exit 3)."""
+    if isinstance(exc, ConfigError):
+        print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(f"thruster-hil campaign: run error: {exc}", file=sys.stderr)
+    return EXIT_RUN_ERROR
 
 
 def checked_cases(spec: CampaignSpec) -> tuple[str, list[dict[str, Any]], float]:
@@ -109,7 +125,7 @@ def checked_cases(spec: CampaignSpec) -> tuple[str, list[dict[str, Any]], float]
 
 def _prepare(out: Path, spec: CampaignSpec, text: str, cases: list[dict[str, Any]]) -> None:
     if out.exists() and not out.is_dir():
-        raise ConfigError("command line", "--out", str(out), "a folder (this is a file)")
+        new_folder(out)
     # what the results depend on: the scenario, which traces are kept, and each case (a
     # campaign with more or fewer cases of the same draws extends or trims this one)
     digests = {c["name"]: _sha(json.dumps(c, sort_keys=True)) for c in cases}
@@ -126,8 +142,8 @@ def _prepare(out: Path, spec: CampaignSpec, text: str, cases: list[dict[str, Any
             raise ConfigError("command line", "--out", str(out), "an empty folder or this "
                               f"campaign's own (it holds another campaign: {why})")
         digests = {**old.get("cases", {}), **digests}
-    elif out.exists() and any(out.iterdir()):
-        raise ConfigError("command line", "--out", str(out), "a new or empty folder")
+    else:
+        new_folder(out)
     out.mkdir(parents=True, exist_ok=True)
     (out / SCENARIO_COPY).write_text(text, encoding="utf-8")
     shutil.copyfile(spec.source, out / CAMPAIGN_COPY)
@@ -139,15 +155,15 @@ def _sha(text: str) -> str:
 
 
 def _decimate(run_dir: Path) -> None:
+    """Keep the header and every TELEMETRY_DECIMATION-th row, streamed (flat memory)."""
     path = run_file(run_dir, "telemetry.csv")
     if not path.exists():
         return
-    lines = list(read_lines(path))
-    kept = lines[:1] + lines[1::TELEMETRY_DECIMATION]
     tmp = path.with_name(path.name + ".tmp")
     opener = gzip.open if path.suffix == ".gz" else open
     with opener(tmp, "wt", encoding="utf-8") as f:
-        f.writelines(kept)
+        f.writelines(line for i, line in enumerate(read_lines(path))
+                     if i == 0 or (i - 1) % TELEMETRY_DECIMATION == 0)
     tmp.replace(path)
 
 
@@ -308,10 +324,8 @@ def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
         run_dir = campaign_dir / "reruns" / name
         if run_dir.exists():
             shutil.rmtree(run_dir)
-    elif out.exists() and any(out.iterdir()):
-        raise ConfigError("command line", "--out", str(out), "a new or empty folder")
     else:
-        run_dir = out
+        run_dir = new_folder(out)
     import subprocess
 
     cmd = [sys.executable, "-m", "bench.operator.cli",

@@ -57,7 +57,7 @@ def margin_search(scenario: Path, key: str, toward: float, requirement: str, out
     data = parse_toml(text, str(scenario))
     apply_overrides(data, list(overrides), "command line --set")
     sc = parse_scenario(copy.deepcopy(data), str(scenario))
-    base = with_defaults(spec, data, len(sc.thrusters))
+    base = with_defaults([spec.dispersions[0].parts], data, len(sc.thrusters))
     try:
         paths = expand(base, spec.dispersions[0].parts)
     except KeyError as exc:

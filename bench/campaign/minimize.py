@@ -22,8 +22,8 @@ from pathlib import Path
 from typing import Any
 
 from bench.campaign.case_run import CASE_FILE, STATUS_OK, run_case
-from bench.campaign.cases import ABSENT_DEFAULTS
-from bench.campaign.paths import get_value, leaf_key, parse_key, set_value, toml_value
+from bench.campaign.cases import with_defaults
+from bench.campaign.paths import get_value, leaf_key, leaf_path, parse_key, set_value, toml_value
 from bench.campaign.spec import CASE_TIMEOUT_BASE_S
 from bench.scenario.load import apply_overrides
 from bench.scenario.parse import parse_scenario
@@ -38,7 +38,7 @@ DEFAULT_MAX_RUNS = 60
 def _split(case: dict[str, Any]) -> tuple[list[str], dict[str, Any]]:
     """The case's overrides that are not dispersions (kept), and its values by key."""
     values = {k: v for k, v in case["values"]}
-    leaves = {leaf_key(parse_key("case.json", "values", k)) for k in values}
+    leaves = {leaf_key(parse_key(CASE_FILE, "values", k)) for k in values}
     kept = [o for o in case["overrides"] if o.partition("=")[0] not in leaves]
     return kept, values
 
@@ -48,10 +48,9 @@ def _overrides(base: dict[str, Any], chosen: dict[str, Any]) -> list[str]:
     data = copy.deepcopy(base)
     leaves: dict[str, Any] = {}
     for key, v in chosen.items():
-        parts = parse_key("case.json", "values", key)
+        parts = parse_key(CASE_FILE, "values", key)
         set_value(data, parts, v)
-        leaf = leaf_key(parts)
-        leaves[leaf] = (*parts[:-1], (parts[-1][0], ()))
+        leaves[leaf_key(parts)] = leaf_path(parts)
     return [f"{k}={toml_value(get_value(data, p))}" for k, p in leaves.items()]
 
 
@@ -70,13 +69,7 @@ def minimize(campaign_dir: Path, name: str, out: Path,
     apply_overrides(base, kept, f"{name}: kept overrides")
     sc = parse_scenario(copy.deepcopy(base), str(scenario))
     n = len(sc.thrusters)
-    for leaf, fill in ABSENT_DEFAULTS.items():
-        table: dict[str, Any] = base
-        *tables, last = leaf.split(".")
-        if any(leaf_key(parse_key("c", "k", k)) == leaf for k in values):
-            for t in tables:
-                table = table.setdefault(t, {})
-            table.setdefault(last, fill(n))
+    base = with_defaults([parse_key(CASE_FILE, "values", k) for k in values], base, n)
     timeout = CASE_TIMEOUT_BASE_S + sc.duration_s
     trials: list[dict[str, Any]] = []
     result: dict[str, Any] = {}
@@ -112,7 +105,7 @@ def minimize(campaign_dir: Path, name: str, out: Path,
         chosen = dict(values)
         groups: dict[str, list[str]] = {}
         for k in values:
-            groups.setdefault(leaf_key(parse_key("c", "k", k)), []).append(k)
+            groups.setdefault(leaf_key(parse_key(CASE_FILE, "values", k)), []).append(k)
         for keys in groups.values():  # whole dispersions first
             trial = {k: v for k, v in chosen.items() if k not in keys}
             if len(trial) < len(chosen) and fails(trial):

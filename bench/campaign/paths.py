@@ -8,7 +8,8 @@ index (``thrusters.actual_thrust_scale[*]``: one value per thruster).
 - :func:`parse_key` splits a key into parts (errors name the campaign file and key);
 - :func:`expand` turns ``[*]`` into the indices the data has;
 - :func:`get_value` / :func:`set_value` read and write one concrete path;
-- :func:`leaf_key` is the ``--set`` key that carries the whole leaf of a path
+- :func:`leaf_key` is the ``--set`` key that carries the whole leaf of a path (and
+  :func:`leaf_path` that leaf's path)
   (``initial.omega_BN_B_deg_s`` for ``initial.omega_BN_B_deg_s[2]``);
 - :func:`toml_value` writes a value back as TOML (floats by ``repr``: read back exactly).
 """
@@ -120,6 +121,11 @@ def leaf_key(path: tuple[Part, ...]) -> str:
     """The ``--set`` key of the whole leaf: indices kept on the tables, dropped on the leaf."""
     names = [f"{n}{''.join(f'[{i}]' for i in idx)}" for n, idx in path[:-1]]
     return ".".join([*names, path[-1][0]]) if path else ""
+
+
+def leaf_path(path: tuple[Part, ...]) -> tuple[Part, ...]:
+    """The path of the whole leaf (its element indices dropped): what :func:`leaf_key` names."""
+    return (*path[:-1], (path[-1][0], ()))
 
 
 def path_text(path: tuple[Part, ...]) -> str:

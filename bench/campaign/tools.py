@@ -20,15 +20,14 @@ from __future__ import annotations
 
 import argparse
 import shutil
-import sys
 from pathlib import Path
 
+from bench.campaign.cli import EXIT_FAILED, error_exit, new_folder
 from bench.campaign.minimize import DEFAULT_MAX_RUNS
 from dbc import options as opt
 from dbc.errors import ConfigError, RunError
 from dbc.options import StrictParser
 
-EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 1, 2, 3
 MAX_MINIMIZE_RUNS = 10_000
 
 
@@ -72,19 +71,12 @@ def _parser() -> StrictParser:
     return p
 
 
-def _new_folder(out: Path) -> Path:
-    """``--out``: a folder that does not exist or is empty (nothing of the user's replaced)."""
-    if out.exists() and (not out.is_dir() or any(out.iterdir())):
-        raise ConfigError("command line", "--out", str(out), "a new or empty folder")
-    return out
-
-
 def _minimize(args: argparse.Namespace) -> int:
     from bench.campaign.minimize import minimize
 
     d = Path(args.campaign_dir)
     if args.out:
-        out = _new_folder(Path(args.out))
+        out = new_folder(Path(args.out))
     else:  # the campaign's own folder for it: an earlier search is replaced
         out = d / "minimal" / args.case
         shutil.rmtree(out, ignore_errors=True)
@@ -116,13 +108,9 @@ def main(argv: list[str]) -> int:
         from bench.campaign.margin import margin_search
 
         r = margin_search(Path(args.scenario), args.key, args.toward, args.requirement,
-                          _new_folder(Path(args.out)), args.tolerance, tuple(args.overrides))
-    except ConfigError as exc:
-        print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except RunError as exc:
-        print(f"thruster-hil campaign: run error: {exc}", file=sys.stderr)
-        return EXIT_RUN_ERROR
+                          new_folder(Path(args.out)), args.tolerance, tuple(args.overrides))
+    except (ConfigError, RunError) as exc:
+        return error_exit(exc)
     if r.get("boundary") is None:
         print(f"margin of {r['key']} for {r['requirement']}: {r['note']} ({r['runs']} runs)")
         if r.get("nominal_fails"):

@@ -29,7 +29,11 @@ from pathlib import Path
 from typing import Any
 
 from bench.campaign.cases import build_cases
-from bench.campaign.cli import SCENARIO_COPY, run_campaign_file
+from bench.campaign.cli import (
+    SCENARIO_COPY,
+    error_exit,
+    run_campaign_file,
+)
 from bench.campaign.spec import is_campaign_file
 from bench.operator.report_html import campaign_html
 from bench.scenario.load import load_scenario
@@ -42,7 +46,6 @@ from dbc.records import write_record
 
 KINDS = (STUCK_CLOSED, STUCK_OPEN)
 DEFAULT_FAULT_TIME_S = 10.0
-EXIT_BAD_INPUT, EXIT_RUN_ERROR = 2, 3  # as thruster-hil run's
 COLUMNS = ["thruster", "kind", "detected", "detection_time_s", "isolated_thruster",
            "isolation_correct", "expectations_met", "final_attitude_error_deg",
            "final_position_error_m", "propellant_kg", "run_dir"]
@@ -100,11 +103,15 @@ def run_campaign(scenario: Path, out: Path, fault_t_s: float, jobs: int,
     out.mkdir(parents=True, exist_ok=True)
     (out / SCENARIO_COPY).write_text(text, encoding="utf-8")
 
+    made: dict[str, dict[str, Any]] = {}  # each case's row, read from its summary once
+
     def row_of(r: dict[str, Any]) -> dict[str, Any]:
-        kind, k = r["failure"]
-        run_dir = out / "cases" / r["name"] / "run"
-        s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
-        return _row(k, kind, s, r["figures"]["detection_time_s"], run_dir)
+        if r["name"] not in made:
+            kind, k = r["failure"]
+            run_dir = out / "cases" / r["name"] / "run"
+            s = json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))
+            made[r["name"]] = _row(k, kind, s, r["figures"]["detection_time_s"], run_dir)
+        return made[r["name"]]
 
     def show(done: int, total: int, r: dict[str, Any]) -> None:
         if progress is not None and r["status"] == "ok":  # the others: an error below
@@ -240,12 +247,8 @@ def main(argv: list[str] | None = None) -> int:
                             DEFAULT_FAULT_TIME_S if args.fault_time is None else args.fault_time,
                             args.jobs or max(1, (os.cpu_count() or 2) // 2),
                             tuple(args.kinds or KINDS), _progress_printer())
-    except ConfigError as exc:
-        print(f"thruster-hil campaign: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except RunError as exc:
-        print(f"thruster-hil campaign: run error: {exc}", file=sys.stderr)
-        return EXIT_RUN_ERROR
+    except (ConfigError, RunError) as exc:
+        return error_exit(exc)
     if sys.stderr.isatty():  # a redirected campaign has printed each run as it ended
         for r in rows:
             print(_row_line(r))

@@ -22,6 +22,12 @@ POLL_S = 0.05  # polling the campaign folder for its first finished case
 pytestmark = pytest.mark.slow
 
 
+def _campaign_file(path: Path, body: str) -> Path:
+    """A campaign file on the quickstart: ``[campaign]``'s scenario line, then ``body``."""
+    path.write_text(f'[campaign]\nscenario = "{QUICKSTART}"\n' + body, encoding="utf-8")
+    return path
+
+
 def _hil(args: list[str], runtime: Path) -> subprocess.CompletedProcess[str]:
     import os
 
@@ -32,13 +38,12 @@ def _hil(args: list[str], runtime: Path) -> subprocess.CompletedProcess[str]:
 
 def test_small_monte_carlo_reruns_and_resumes(tmp_path: Path, runtime: Path) -> None:
     """3 cases: rows, report links, statistics; rerun identical; a lost case rerun alone."""
-    f = tmp_path / "mc.toml"
-    f.write_text(
-        f'[campaign]\nscenario = "{QUICKSTART}"\ncases = {CASES}\nseed = 11\n'
+    f = _campaign_file(
+        tmp_path / "mc.toml",
+        f'cases = {CASES}\nseed = 11\n'
         'set = ["scenario.duration_s=3.0", "expectations.steady_state_window_s=1.0"]\n'
         '[[dispersions]]\nname = "thrust_scale"\ndist = "normal"\nmean = 1.0\nsigma = 0.05\n'
-        '[[dispersions]]\nname = "latency"\ndist = "uniform"\nlow = 0.0005\nhigh = 0.003\n',
-        encoding="utf-8")
+        '[[dispersions]]\nname = "latency"\ndist = "uniform"\nlow = 0.0005\nhigh = 0.003\n')
     out = tmp_path / "out"
     first = _hil(["campaign", str(f), "--out", str(out)], runtime)
     assert first.returncode in (0, 1), first.stderr[-3000:]
@@ -84,13 +89,12 @@ def test_small_monte_carlo_reruns_and_resumes(tmp_path: Path, runtime: Path) -> 
 def test_minimal_failure_names_the_dispersion_that_fails(tmp_path: Path, runtime: Path) -> None:
     """A 90 ms valve opening delay fails the 12 s quickstart, a 0.1 deg/s initial rate does
     not: the minimal failure keeps the delay alone, the rate back at nominal."""
-    f = tmp_path / "f.toml"
-    f.write_text(
-        f'[campaign]\nscenario = "{QUICKSTART}"\nstudy = "factorial"\n'
+    f = _campaign_file(
+        tmp_path / "f.toml",
+        'study = "factorial"\n'
         'set = ["scenario.duration_s=12.0", "expectations.steady_state_window_s=4.0"]\n'
         '[[dispersions]]\nname = "initial_rate"\ndist = "sweep"\nvalues = [0.1]\n'
-        '[[dispersions]]\nname = "open_delay"\ndist = "sweep"\nvalues = [0.09]\n',
-        encoding="utf-8")
+        '[[dispersions]]\nname = "open_delay"\ndist = "sweep"\nvalues = [0.09]\n')
     out = tmp_path / "out"
     run = _hil(["campaign", str(f), "--out", str(out)], runtime)
     assert run.returncode == 1, run.stdout[-2000:] + run.stderr[-2000:]  # the one case fails
@@ -112,12 +116,11 @@ def test_an_interrupted_campaign_resumes(tmp_path: Path, runtime: Path) -> None:
     import time
 
     cases = 6
-    f = tmp_path / "mc.toml"
-    f.write_text(
-        f'[campaign]\nscenario = "{QUICKSTART}"\ncases = {cases}\nseed = 3\n'
+    f = _campaign_file(
+        tmp_path / "mc.toml",
+        f'cases = {cases}\nseed = 3\n'
         'set = ["scenario.duration_s=6.0", "expectations.steady_state_window_s=2.0"]\n'
-        '[[dispersions]]\nname = "latency"\ndist = "uniform"\nlow = 0.0005\nhigh = 0.003\n',
-        encoding="utf-8")
+        '[[dispersions]]\nname = "latency"\ndist = "uniform"\nlow = 0.0005\nhigh = 0.003\n')
     out = tmp_path / "out"
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime))
     p = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", "campaign", str(f),
@@ -146,12 +149,11 @@ def test_a_hung_case_is_retried_once_then_recorded_as_an_error(tmp_path: Path,
                                                                runtime: Path) -> None:
     """case_timeout_s = 1 s on 30 s cases: each case is stopped, retried, then listed as an
     error (exit 3), none dropped, no run left behind."""
-    f = tmp_path / "hang.toml"
-    f.write_text(
-        f'[campaign]\nscenario = "{QUICKSTART}"\ncases = 2\ncase_timeout_s = 1.0\n'
+    f = _campaign_file(
+        tmp_path / "hang.toml",
+        'cases = 2\ncase_timeout_s = 1.0\n'
         'set = ["scenario.duration_s=30.0"]\n'
-        '[[dispersions]]\nname = "latency"\ndist = "sweep"\nvalues = [0.001]\n',
-        encoding="utf-8")
+        '[[dispersions]]\nname = "latency"\ndist = "sweep"\nvalues = [0.001]\n')
     out = tmp_path / "out"
     run = _hil(["campaign", str(f), "--out", str(out)], runtime)
     assert run.returncode == 3, run.stdout[-2000:] + run.stderr[-2000:]

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from bench.operator.campaign import EXIT_BAD_INPUT, main
+from bench.campaign.cli import EXIT_BAD_INPUT
+from bench.operator.campaign import main
 
 REPO = Path(__file__).resolve().parents[3]
 QUICKSTART = REPO / "scenarios" / "quickstart.toml"
@@ -66,3 +67,28 @@ def test_rerun_never_deletes_a_folder_it_did_not_make(
     code = tool_main(["rerun", str(tmp_path / "camp"), "0001", "--out", str(out)])
     assert code == EXIT_BAD_INPUT and "a new or empty folder" in capsys.readouterr().err
     assert (out / "keep.txt").read_text(encoding="utf-8") == "mine"
+
+
+def test_prune_drops_a_passing_case_trace_and_keeps_every_tenth_row(tmp_path: Path) -> None:
+    """A passing case that is not among the worst: its trace gone, its telemetry the header
+    and rows 0, 10, 20; a failing case untouched."""
+    import gzip
+
+    from bench.campaign.cli import TELEMETRY_DECIMATION, prune
+
+    rows = []
+    for name, passed in (("0000", True), ("0001", False)):
+        run = tmp_path / "cases" / name / "run"
+        run.mkdir(parents=True)
+        (run.parent / "result.json").write_text("{}", encoding="utf-8")
+        with gzip.open(run / "telemetry.csv.gz", "wt", encoding="utf-8") as f:
+            f.write("t_s\n" + "".join(f"{i}\n" for i in range(25)))
+        with gzip.open(run / "trace.asc.gz", "wt", encoding="utf-8") as f:
+            f.write("date x\n")
+        rows.append({"name": name, "status": "ok", "passed": passed})
+    assert prune(tmp_path, rows, {"worst": {}}, "failing") == 1
+    kept = tmp_path / "cases" / "0000" / "run"
+    with gzip.open(kept / "telemetry.csv.gz", "rt", encoding="utf-8") as f:
+        assert f.read().split() == ["t_s", *(str(i) for i in range(0, 25, TELEMETRY_DECIMATION))]
+    assert not (kept / "trace.asc.gz").exists()
+    assert (tmp_path / "cases" / "0001" / "run" / "trace.asc.gz").exists()

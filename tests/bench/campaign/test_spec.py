@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 from typing import Any
 
 import pytest
 
+from bench.campaign.cases import with_defaults
+from bench.campaign.paths import expand, parse_key
 from bench.campaign.spec import ALIASES, load_campaign, parse_campaign
 from bench.scenario.parse import parse_scenario
 from dbc.datafile import parse_toml
@@ -23,12 +26,15 @@ def test_shipped_campaigns_load(path: Path) -> None:
     assert spec.scenario.exists() and spec.dispersions
 
 
-def test_every_alias_names_a_key_of_a_scenario_or_a_default() -> None:
-    """Each alias's first name is a table the scenario format has."""
+@pytest.mark.parametrize("alias", sorted(ALIASES))
+def test_every_alias_names_keys_the_scenario_has_or_fills(alias: str) -> None:
+    """On the quickstart with one fault scheduled, each alias's key expands to at least one
+    element, filled with its nominal value where the scenario leaves it out."""
     data = parse_toml((REPO / "scenarios" / "quickstart.toml").read_text(), "q")
-    parse_scenario(data, "q")
-    tables = {"vehicle", "thrusters", "sensors", "initial", "bus", "faults"}
-    assert {k.split(".")[0].split("[")[0] for k in ALIASES.values()} <= tables
+    data["faults"] = [{"t_s": 1.0, "kind": "stuck_closed", "thruster": 0}]
+    n = len(parse_scenario(copy.deepcopy(data), "q").thrusters)
+    parts = parse_key("test", "alias", ALIASES[alias])
+    assert expand(with_defaults([parts], data, n), parts)
 
 
 @pytest.mark.parametrize("campaign, dispersions, key", [

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from bench.operator.campaign import EXIT_BAD_INPUT, EXIT_RUN_ERROR, main
+from bench.campaign.cli import EXIT_BAD_INPUT, EXIT_RUN_ERROR
+from bench.operator.campaign import main
 
 QUICKSTART = Path(__file__).resolve().parents[3] / "scenarios" / "quickstart.toml"
 
