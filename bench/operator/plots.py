@@ -34,6 +34,10 @@ from transport.lockstep import available_cpus
 
 RAD_DEG = 180.0 / np.pi
 DPI = 110
+# Titles sit at the top of the axes (nothing is drawn above it but the event numbers).
+# Given explicitly, matplotlib skips placing them around top tick labels, which cost
+# ~0.05 s a figure in layout and changed no pixel (same PNG bytes).
+TITLE_Y = 1.0
 ERROR_FLOOR_DEG = 1e-4
 # Points of a line plot at most: 2000 buckets, each drawn as its minimum and maximum
 MAX_PLOT_POINTS = 4000
@@ -126,16 +130,22 @@ def plot_run(run_dir: Path, band_deg: float | None = None,
 
 
 def draw_each(figures: list[tuple[Path, Callable[[Path], None]]]) -> list[Path]:
-    """Write each figure's PNG with its drawer; returns the paths. With more than one CPU
-    the figures after the first are drawn in forked children at the same time (this
-    process has matplotlib loaded already, the children share it). A child that fails
-    makes this raise :class:`RuntimeError` naming the figure (its traceback is printed)."""
-    if len(figures) < 2 or not hasattr(os, "fork") or available_cpus() < 2:
+    """Write each figure's PNG with its drawer; returns the paths.
+
+    With more than one CPU the figures are drawn at the same time, one group per CPU: the
+    first figures (list the slowest first) each in a forked child of its own, this process
+    drawing the rest in turn (it has matplotlib loaded already, the children share it). On
+    two CPUs with three figures that is the slow log-scale one alone and the other two one
+    after the other, ~0.1 s sooner than three processes sharing two CPUs. A child that
+    fails makes this raise :class:`RuntimeError` naming the figure (its traceback is
+    printed)."""
+    workers = min(len(figures), available_cpus()) if hasattr(os, "fork") else 1
+    if workers < 2:
         for path, draw in figures:
             draw(path)
         return [path for path, _ in figures]
     children: list[tuple[int, Path]] = []
-    for path, draw in figures[1:]:
+    for path, draw in figures[:workers - 1]:
         pid = os.fork()
         if pid == 0:  # pragma: no cover - the child reports through its exit status
             code = 0
@@ -150,12 +160,18 @@ def draw_each(figures: list[tuple[Path, Callable[[Path], None]]]) -> list[Path]:
                 sys.stderr.flush()
                 os._exit(code)
         children.append((pid, path))
-    first, draw = figures[0]
+    error: BaseException | None = None
     try:
-        draw(first)
+        for path, draw in figures[workers - 1:]:  # each one, even after one failed
+            try:
+                draw(path)
+            except Exception as exc:
+                error = error or exc
     finally:
         failed = [path.name for pid, path in children
                   if os.waitpid(pid, 0)[1] != 0]
+    if error is not None:
+        raise error
     if failed:
         raise RuntimeError(f"drawing {', '.join(failed)} failed (see the traceback above)")
     return [path for path, _ in figures]
@@ -179,7 +195,7 @@ def _attitude_error(tel: dict[str, np.ndarray], band_deg: float | None) -> plt.F
     ax.set_ylabel("attitude error [deg]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    ax.set_title("Attitude error")
+    ax.set_title("Attitude error", y=TITLE_Y)
     return fig
 
 
@@ -193,7 +209,7 @@ def _rates(tel: dict[str, np.ndarray]) -> plt.Figure:
     ax.set_ylabel("body rate [deg/s]")
     ax.grid(True, alpha=0.3)
     ax.legend()
-    ax.set_title("Body rates (truth)")
+    ax.set_title("Body rates (truth)", y=TITLE_Y)
     return fig
 
 
@@ -209,7 +225,8 @@ def _raster(t: np.ndarray, pulses: dict[str, np.ndarray], n_thr: int) -> plt.Fig
     ax.set_yticklabels([f"T{k}" for k in range(n_thr)])
     ax.set_xlim(t[0], t[-1])
     ax.set_xlabel("time [s]")
-    ax.set_title("Thruster firing raster (commanded coil-on intervals)")
+    ax.set_title("Thruster firing raster (commanded coil-on intervals)",
+                 y=TITLE_Y)
     return fig
 
 
