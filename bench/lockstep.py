@@ -5,7 +5,9 @@ flight software computes, the station integrates up to the earliest moment its a
 arrive and the wire writes what it has resolved; every frame read goes through the
 receive path (bench.wire.receipt, with the awaited cycle); the commands taken are
 delivered to the valves at their modelled arrival (response delay, arbitration, exact
-frame length); the station integrates to t_{k+1}. A missing answer within
+frame length); the station integrates to t_{k+1}. The wall time of each part (before
+SYNC, meanwhile, the wait, after the commands) goes into summary.json's
+``lockstep_wall_us``. A missing answer within
 ``stall_timeout_s`` of wall time is a counted stall (its event names the missing frames);
 after ``SILENT_AFTER_STALLS`` in a row the flight software is declared silent and the
 bench stops waiting for it (never hangs). Deterministic: the same scenario and seed give
@@ -37,6 +39,10 @@ class Lockstep:
     def __init__(self, node: BenchNode) -> None:
         self.node = node
         self.consecutive_stalls = 0
+        # wall-clock marks of the current cycle [ns, the node's clock]: SYNC handed over,
+        # the wait for the answer ended (the per-cycle split in summary.json)
+        self.synced_ns = 0
+        self.answered_ns = 0
 
     def run(self, duration_s: float) -> None:
         """Lockstep run of ``duration_s`` simulated seconds."""
@@ -62,9 +68,13 @@ class Lockstep:
             n._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S}, max(t_k, wire.last_rx_ns))
             wire.release()
             wire.flush()
+            self.synced_ns = clock.now_ns()
             self._collect(k, wire.last_rx_ns + delay_ns, duration_s)
             n.integrate_to(t_k + period)
-            results.cycle_wall_ns.add(clock.now_ns() - cycle_wall0)
+            cycle_wall1 = clock.now_ns()
+            results.cycle_wall_ns.add(cycle_wall1 - cycle_wall0)
+            results.before_sync_ns.add(self.synced_ns - cycle_wall0)
+            results.after_commands_ns.add(cycle_wall1 - self.answered_ns)
         wire.release()
         wire.flush()
         n._samples.clear()
@@ -95,6 +105,7 @@ class Lockstep:
         timeout_ns = (0 if (st.fsw_silent or fsw_dead)
                       else round(n.sc.bus.stall_timeout_s * NS_PER_S))
         wait0 = n.clock.now_ns()
+        results.meanwhile_ns.add(wait0 - self.synced_ns)
         deadline = wait0 + timeout_ns
         imu_counter: int | None = None
         want = len(n.cmd_frames)
@@ -126,7 +137,8 @@ class Lockstep:
                 n._events(events)
                 events = []
         n._second_sender()
-        results.fsw_wait_ns.add(n.clock.now_ns() - wait0)
+        self.answered_ns = n.clock.now_ns()
+        results.fsw_wait_ns.add(self.answered_ns - wait0)
         rx = wire.flush(ready_ns + n.period_ns)
         if any(g[1] not in rx for g in got):  # a congested wire: resolve what is left
             rx.update(wire.flush())

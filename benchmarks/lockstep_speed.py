@@ -54,6 +54,8 @@ SCENARIOS = REPO / "scenarios"
 QUICKSTART = SCENARIOS / "quickstart.toml"
 NS_PER_S = 1e9
 PACKAGES = ("bench", "dbc", "flight_sw", "transport")
+# a lockstep cycle's parts, in order (summary.json lockstep_wall_us; bench.lockstep)
+SPLIT = ("before_sync", "meanwhile", "waiting_for_fsw", "after_commands")
 
 
 def _timed(argv: list[str], env: dict[str, str]) -> float:
@@ -94,6 +96,8 @@ def _scenario_figures(summaries: list[dict[str, Any]]) -> dict[str, Any]:
         "cycle_wall_us": {"p50": cycle_p50, "p99": _median([c["p99"] for c in cycle])},
         "waiting_for_fsw_us": {"p50": wait_p50, "p99": _median([w["p99"] for w in wait])},
         "bench_own_us_p50": cycle_p50 - wait_p50,
+        "split_us_p50": {part: _median([s["lockstep_wall_us"][part]["p50"] for s in summaries])
+                         for part in SPLIT},
         "fsw_cycle_us": {k: _median([f[k] for f in fsw if k in f]) for k in ("p50", "p99", "max")
                          if any(k in f for f in fsw)},
         "passed": [s["passed"] for s in summaries],

@@ -62,6 +62,12 @@ class Results:
         self.latency_ns = Distribution(1 if mode == "lockstep" else MEASURED_QUANTUM_NS)
         self.cycle_wall_ns = Distribution(MEASURED_QUANTUM_NS)
         self.fsw_wait_ns = Distribution(MEASURED_QUANTUM_NS)
+        # the rest of a lockstep cycle, in its order (bench.lockstep): the samples and SYNC
+        # handed over; the bench's work while the flight software computes, until it waits;
+        # (the wait); the commands delivered and the integration to the next cycle
+        self.before_sync_ns = Distribution(MEASURED_QUANTUM_NS)
+        self.meanwhile_ns = Distribution(MEASURED_QUANTUM_NS)
+        self.after_commands_ns = Distribution(MEASURED_QUANTUM_NS)
         self.stalls = 0
         self.late_steps = 0
         self.max_lag_ns = 0
@@ -154,6 +160,9 @@ class Results:
             "lockstep_wall_us": None if self.mode != "lockstep" else {
                 "cycle": latency_summary(self.cycle_wall_ns),
                 "waiting_for_fsw": latency_summary(self.fsw_wait_ns),
+                "before_sync": latency_summary(self.before_sync_ns),
+                "meanwhile": latency_summary(self.meanwhile_ns),
+                "after_commands": latency_summary(self.after_commands_ns),
                 "spin_s": self.lockstep_spin_s,
             },
             "deadline_misses": {

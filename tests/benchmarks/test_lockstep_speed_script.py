@@ -30,6 +30,10 @@ def test_lockstep_speed_reports_the_factor_the_cycle_split_and_the_command() -> 
     assert q["realtime_factor_median"] > 1.0
     assert 0.0 < q["waiting_for_fsw_us"]["p50"] <= q["cycle_wall_us"]["p50"]
     assert q["bench_own_us_p50"] > 0.0 and q["fsw_cycle_us"]["p50"] > 0.0
+    assert set(q["split_us_p50"]) == {"before_sync", "meanwhile", "waiting_for_fsw",
+                                      "after_commands"}
+    assert all(v > 0.0 for v in q["split_us_p50"].values())
+    assert r["bytecode"] == "cached"
     c = r["command"]
     for key in ("plots", "no_plots"):
         assert c[key]["command_s_median"] > c[key]["loop_s_median"] > 0.0, key

@@ -9,6 +9,7 @@ import can
 import pytest
 
 from dbc import e2e
+from dbc.codec import cycle_time_ns
 from dbc.database import load_database
 from tests.e2e.conftest import QUICKSTART, Run, run_cli, trace_lines, unique_bus
 from tests.run_files import run_text
@@ -83,6 +84,22 @@ def test_run_folder_is_complete(quickstart: Run) -> None:
     assert set(SUMMARY_KEYS) <= set(s)
     lat = s["latency_us"]["sensor_to_command"]
     assert lat["n"] > 0 and 0 < lat["p50"] <= lat["p99"] <= lat["max"]
+
+
+CYCLE_PARTS = ("before_sync", "meanwhile", "waiting_for_fsw", "after_commands")
+PARTS_ROUNDING_US = 4 * 1.0  # each part and the cycle are kept to the microsecond
+
+
+def test_each_lockstep_cycle_is_split_into_its_parts(quickstart: Run) -> None:
+    """Every cycle has each part measured once, and no part is longer than a whole cycle."""
+    wall = quickstart.summary["lockstep_wall_us"]
+    cycle = wall["cycle"]
+    period_s = cycle_time_ns(load_database(), "SYNC") / 1e9
+    assert cycle["n"] == round(quickstart.summary["sim_time_s"] / period_s)
+    for part in CYCLE_PARTS:
+        assert wall[part]["n"] == cycle["n"], part
+        assert 0.0 <= wall[part]["p50"] <= wall[part]["max"] <= cycle["max"] + PARTS_ROUNDING_US
+    assert sum(wall[part]["max"] for part in CYCLE_PARTS) >= cycle["p50"]
 
 
 def test_frame_counts_match_between_sender_and_receiver(quickstart: Run) -> None:
