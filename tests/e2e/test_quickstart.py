@@ -16,6 +16,7 @@ from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
 
+NS_PER_S = 1e9
 SETTLING_MAX_S = 10.0
 ASC_RESOLUTION_S = 1e-6  # the ASC trace's timestamps have 6 decimals
 STEADY_STATE_MAX_DEG = 0.1
@@ -87,18 +88,20 @@ def test_run_folder_is_complete(quickstart: Run) -> None:
 
 
 CYCLE_PARTS = ("before_sync", "meanwhile", "waiting_for_fsw", "after_commands")
-PARTS_ROUNDING_US = 4 * 1.0  # each part and the cycle are kept to the microsecond
+# Each part and the cycle are measured in ns and kept rounded to the microsecond, so a
+# part's maximum may exceed the cycle's by that rounding alone.
+ROUNDING_US = 1.0
 
 
 def test_each_lockstep_cycle_is_split_into_its_parts(quickstart: Run) -> None:
     """Every cycle has each part measured once, and no part is longer than a whole cycle."""
     wall = quickstart.summary["lockstep_wall_us"]
     cycle = wall["cycle"]
-    period_s = cycle_time_ns(load_database(), "SYNC") / 1e9
-    assert cycle["n"] == round(quickstart.summary["sim_time_s"] / period_s)
+    period_ns = cycle_time_ns(load_database(), "SYNC")
+    assert cycle["n"] == round(quickstart.summary["sim_time_s"] * NS_PER_S / period_ns)
     for part in CYCLE_PARTS:
         assert wall[part]["n"] == cycle["n"], part
-        assert 0.0 <= wall[part]["p50"] <= wall[part]["max"] <= cycle["max"] + PARTS_ROUNDING_US
+        assert 0.0 <= wall[part]["p50"] <= wall[part]["max"] <= cycle["max"] + ROUNDING_US
     assert sum(wall[part]["max"] for part in CYCLE_PARTS) >= cycle["p50"]
 
 
