@@ -6,14 +6,22 @@ torque matrix (3×8, 15 N) and the seed-001 Table 1 torque matrix (3×8, −2.3�
 ρ = 0.1, the paper's perturbation structures). Demands are half attainable
 (``B·T`` with T uniform in the bounds) and half random directions of the same scale.
 
-Usage: ``python benchmarks/allocation_solve.py [n_demands]`` (default 2000).
+Then the first solve (``first_solve``): for every matrix and allocator, a fresh Python
+process imports the strategy, builds it and times its first ``allocate``, cold and after
+``warm_up()`` (what the flight software does before its first control cycle); medians
+over ``--first-repeats`` processes, with the build and warm-up times.
+
+Usage: ``python benchmarks/allocation_solve.py [n_demands] [--first-repeats K]``
+(defaults 2000 and 3; ``--first-repeats 0`` skips the fresh processes).
 Wall-clock timing is the point of a benchmark; it is not flight code.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
+import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -30,6 +38,7 @@ from flight_sw.allocation.robust_polytopic import RobustParams, RobustPolytopicA
 from flight_sw.allocation.uncertainty import SEED001_LFT_E_SHAPE, SEED001_LFT_H
 
 DEFAULT_N_DEMANDS = 2000
+DEFAULT_FIRST_REPEATS = 3
 SEED = 12345
 P99 = 99.0
 US_PER_S = 1e6
@@ -80,11 +89,9 @@ def _time(alloc: object, demands: np.ndarray) -> dict[str, float]:
     }
 
 
-def main(argv: list[str]) -> None:
-    """Run the benchmark and print the JSON report."""
-    n = int(argv[1]) if len(argv) > 1 else DEFAULT_N_DEMANDS
-    rng = np.random.default_rng(SEED)
-    cases = {
+def _cases() -> dict[str, tuple[np.ndarray, float, float, bool]]:
+    """Matrix, lower and upper bound [N] and whether the paper's LFT E, H apply, per case."""
+    return {
         "seed000_16thr_6row": (
             _matrix(seed000_conventional_16(*SEED000_DIMS_M)),
             0.0,
@@ -105,8 +112,59 @@ def main(argv: list[str]) -> None:
             True,
         ),
     }
+
+
+def _first_solve_child(case: str, kind: str, warm: bool) -> None:
+    """In a fresh process: build one allocator, optionally warm it up, time its first solve."""
+    b, lo, hi, paper = _cases()[case]
+    demand = np.random.default_rng(SEED).uniform(lo, hi, b.shape[1]) @ b.T
+    t0 = time.perf_counter()
+    alloc = _allocators(lo, hi, paper)[kind](b)
+    t1 = time.perf_counter()
+    if warm:
+        alloc.warm_up()  # type: ignore[attr-defined]
+    t2 = time.perf_counter()
+    alloc.allocate(demand)  # type: ignore[attr-defined]
+    t3 = time.perf_counter()
+    print(json.dumps([(t1 - t0) * US_PER_S, (t2 - t1) * US_PER_S, (t3 - t2) * US_PER_S]))
+
+
+def _first_solve(repeats: int) -> dict[str, dict[str, dict[str, float]]]:
+    """Median first-solve, build and warm-up times [µs] over fresh processes."""
+    out: dict[str, dict[str, dict[str, float]]] = {}
+    for case, (_, lo, hi, paper) in _cases().items():
+        out[case] = {}
+        for kind in _allocators(lo, hi, paper):
+            runs: dict[bool, list[list[float]]] = {False: [], True: []}
+            for _ in range(repeats):
+                for warm in (False, True):
+                    cmd = [sys.executable, __file__, "--first-child", case, kind, str(int(warm))]
+                    done = subprocess.run(cmd, capture_output=True, text=True, check=True)
+                    runs[warm].append(json.loads(done.stdout))
+            cold, warm_runs = np.array(runs[False]), np.array(runs[True])
+            out[case][kind] = {
+                "build_us": round(float(np.median(cold[:, 0])), 1),
+                "first_cold_us": round(float(np.median(cold[:, 2])), 1),
+                "warm_up_us": round(float(np.median(warm_runs[:, 1])), 1),
+                "first_after_warm_up_us": round(float(np.median(warm_runs[:, 2])), 1),
+            }
+    return out
+
+
+def main(argv: list[str]) -> None:
+    """Run the benchmark and print the JSON report."""
+    if len(argv) > 1 and argv[1] == "--first-child":
+        _first_solve_child(argv[2], argv[3], argv[4] == "1")
+        return
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("n_demands", nargs="?", type=int, default=DEFAULT_N_DEMANDS)
+    parser.add_argument("--first-repeats", type=int, default=DEFAULT_FIRST_REPEATS,
+                        help="fresh processes per allocator for the first-solve times (0: skip)")
+    args = parser.parse_args(argv[1:])
+    n = args.n_demands
+    rng = np.random.default_rng(SEED)
     report: dict[str, dict[str, dict[str, float]]] = {}
-    for name, (b, lo, hi, paper) in cases.items():
+    for name, (b, lo, hi, paper) in _cases().items():
         half = n // 2
         scale = float(np.abs(b).max()) * hi
         demands = np.vstack(
@@ -116,7 +174,10 @@ def main(argv: list[str]) -> None:
             ]
         )
         report[name] = {k: _time(f(b), demands) for k, f in _allocators(lo, hi, paper).items()}
-    print(json.dumps(report, indent=2))
+    full: dict[str, object] = {"per_call": report}
+    if args.first_repeats > 0:
+        full["first_solve"] = _first_solve(args.first_repeats)
+    print(json.dumps(full, indent=2))
 
 
 if __name__ == "__main__":

@@ -202,6 +202,8 @@ def build_computer(
     root.done()
     n = len(vehicle.r_thr_B_m)
     by_mask = _single_failure_allocators(allocator, n) if precompute else {}
+    for alloc in (allocator, *by_mask.values()):
+        alloc.warm_up()  # first-call costs paid here, not in the first control cycle
 
     def make_estimator() -> AttitudeEstimator:
         # the table was validated above; rebuilding it cannot fail

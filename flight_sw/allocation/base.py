@@ -54,6 +54,11 @@ MAX_DEMAND_DIM = 6
 RANK_RTOL = 1e-10
 # A residual below ATTAINED_RTOL × max(1, bound range × largest column norm) counts as zero.
 ATTAINED_RTOL = 1e-9
+# Warm-up demands: B·T with the thrusters alternately at these fractions of their range
+# (attainable, not cancelling on symmetric layouts), and each axis alone at this multiple
+# of its reach (saturating: the bounded paths).
+WARM_UP_FRACTIONS = (0.2, 0.8)
+WARM_UP_BEYOND_REACH = 2.0
 
 BoundSpec = float | tuple[float, ...]
 A = TypeVar("A", bound="ControlAllocation")
@@ -87,6 +92,10 @@ class Allocator(Protocol):
 
     def with_mask(self, mask: Sequence[bool] | np.ndarray) -> Allocator:
         """A new allocator, identical but for the availability mask (True = usable)."""
+        ...
+
+    def warm_up(self) -> None:
+        """Pay the first-call costs before the first control cycle; results unchanged."""
         ...
 
 
@@ -244,6 +253,30 @@ class ControlAllocation:
     def with_mask(self: A, mask: Sequence[bool] | np.ndarray) -> A:
         """A new allocator of the same kind for the same thrusters with availability ``mask``."""
         return type(self)(self._b, self._params, mask, *self._rebuild_args())
+
+    # --- start-up ----------------------------------------------------------------------
+
+    # True when a solve leaves no state behind (no warm start): warm_up then runs on the
+    # instance itself instead of a sibling.
+    _stateless = False
+
+    def warm_up(self) -> None:
+        """Pay the first-call costs (numpy's and the solver's first calls, lazily built
+        tables) before the first control cycle, on demands inside and beyond the thrusters'
+        reach (:data:`WARM_UP_FRACTIONS`, :data:`WARM_UP_BEYOND_REACH`). A strategy that
+        warm-starts is warmed through a sibling with the same mask, so this instance's state,
+        and so every later result, is what it would have been without the warm-up."""
+        target = self if self._stateless else self.with_mask(self._mask)
+        for d in self._warm_up_demands():
+            target.allocate(d)
+
+    def _warm_up_demands(self) -> list[np.ndarray]:
+        lo, hi = self._lo_a, self._hi_a
+        low, high = WARM_UP_FRACTIONS
+        mix = np.where(np.arange(lo.size) % 2 == 0, low, high)
+        reach = np.abs(self._b_a) @ np.maximum(np.abs(lo), np.abs(hi))
+        beyond = WARM_UP_BEYOND_REACH * np.diag(reach)
+        return [self._b_a @ (lo + mix * (hi - lo)), *beyond]
 
     # --- allocation --------------------------------------------------------------------
 

@@ -198,6 +198,7 @@ class PseudoInverseAllocator(ControlAllocation):
     """Bounded pseudo-inverse allocator with null-space shift (a ``ControlAllocation``)."""
 
     _source = "PseudoInverseAllocator"
+    _stateless = True  # no warm start: every solve starts from the same state
 
     def __init__(
         self,

@@ -27,7 +27,7 @@ function) with ``φ'(τ) = ∂f/∂τ`` at the inner minimiser ``T(τ)`` (Danski
    ``M = CᵀDC + HᵀH/τ + εI``, ``c = CᵀD Uᵀv``, ``C = UᵀB₀``, ``D = diag(1/(1 − τ sⱼ))``,
    solved exactly by the dense active-set :func:`~flight_sw.allocation.active_set.box_qp`,
    warm-started from the previous active set;
-2. outer problem: ``φ'(τ) = 0`` on ``θ = τ·max s ∈ [THETA_MIN, LFT_THETA_MAX]`` by
+2. outer problem: ``φ'(τ) = 0`` on ``θ = τ·max s ∈ [LFT_THETA_MIN, LFT_THETA_MAX]`` by
    safeguarded Newton (:func:`~flight_sw.allocation.root_finding.monotone_root`; ``φ''`` from
    the sensitivity of ``T`` on its active set: ``f_ττ − 2 wᵀ M_FF⁻¹ w``), started from the
    previous allocation's θ (cold: :data:`LFT_THETA_START`). It stops when the Newton
@@ -36,10 +36,33 @@ function) with ``φ'(τ) = ∂f/∂τ`` at the inner minimiser ``T(τ)`` (Danski
    *per-round* decrease and could end far from the optimum (0.2 above a scipy reference
    at ρ = 0.5 with a random H).
 
-The one approximation: θ is capped at :data:`LFT_THETA_MAX` = 1 − 1e-6 (near θ = 1 the
-T-step is ill-conditioned). When the optimum is the "hard case" τ* = 1/max s, the value
-returned exceeds the exact one by at most ``|φ'(θ_max)|·(1 − θ_max)`` (convexity), i.e.
-about 1e-6 × the slope: a bound, documented here, not silently exact.
+3. refinement (ε → 0): the search runs with the ridge ``ε‖T‖²`` (it makes ``M`` definite,
+   and the optimum unique), which biases the answer: on seed 001 most demands have an
+   exact optimum of 0 (``B₀T = v`` and ``HT = 0`` inside the box), where the ridge left a
+   worst case of up to 8e-4 N m. At the final τ, the thrusts are replaced by the
+   least-norm minimiser of the unregularised ``f(·, τ)`` on the same active set — the
+   weighted least squares ``[D^½C; H/√τ] T ≈ [D^½Uᵀv; 0]`` solved by SVD
+   (:func:`~flight_sw.allocation.active_set.refine`, well conditioned where
+   the normal equations are not) — kept when they do not raise the unregularised
+   objective. Because ``f(T, τ) ≥ max_F ‖(B₀+EFH)T − v‖²`` for every τ, the worst case
+   of the refined thrusts is at most the unregularised optimum at the final τ.
+
+What ``regularization`` may be: the ridge is a numerical device, not a design choice, so
+it is held to :data:`LFT_REGULARIZATION_RANGE`. Below it, near θ = 1 (where most seed-001
+optima lie: the weight ``1/(1 − θ)`` reaches 1e6) the ridge falls under the Cholesky
+pivot tolerance of ``M`` and the warm-started box QP can stop on a wrong active set
+(0.036 N m above the optimum at ε = 1e-9, and ``regularization = 0`` is refused for the
+same reason: ``M`` is then singular wherever ``H`` and ``B₀`` share a null direction,
+three of the eight on seed 001); above it, the ridge moves the active set and τ enough
+that the refinement on that active set is no longer the exact optimum (2e-4 N m at
+3e-6). Inside the range, on 650 seed-001 demands (the Case-1 torques and random ones),
+the worst case is within 1e-8 N m (5e-8 relative) of an independent SDP solution of
+Theorem 3's LMI (benchmarks/robust_allocation.py; tests/flight_sw/allocation).
+
+The other approximation: θ is held to [:data:`LFT_THETA_MIN`, :data:`LFT_THETA_MAX`] =
+[1e-6, 1 − 1e-6]. When the optimum is the "hard case" τ* = 1/max s, or has ``HT = 0``
+(τ* → 0), the value returned exceeds the exact one by at most ``|φ'|`` at that end times
+1e-6 (convexity): a bound, documented here, not silently exact.
 
 Parameters: ``E = ρ E_shape`` (default ``E_shape = I_m``) and ``H`` (default
 ``diag(‖B₀ e_j‖)``: the error of each thruster's column scales with its effect); seed 001
@@ -86,19 +109,26 @@ from flight_sw.allocation.root_finding import monotone_root
 from flight_sw.allocation.uncertainty import (
     EIG_RTOL,
     SEED001_RHO,
-    THETA_MIN,
     lft_worst_case_residual,
 )
 
 # Stop when a round lowers the objective by less than this fraction of it.
 LFT_RTOL = 1e-10
+# The ridge ε of the τ search (relative to the mean diagonal of B₀ᵀB₀) the refinement
+# makes exact: below, M is numerically singular near θ = 1; above, the ridge moves the
+# active set (see the module docstring).
+LFT_REGULARIZATION_RANGE = (1e-7, 1e-6)
 DEFAULT_MAX_LFT_ITER = 50
 # First θ = τ·σ_max(E)² tried when there is no previous allocation to warm-start from.
 LFT_THETA_START = 0.5
-# The τ search runs on θ = τ·σ_max(E)² in [THETA_MIN, LFT_THETA_MAX]: near θ = 1 the weight
-# 1/(1 − θ) of the worst direction makes the T-step ill-conditioned. φ is convex, so
-# stopping there costs at most |φ'(θ_max)|·(1 − θ_max) of the squared worst case (the
-# "hard case" τ* = 1/σ_max², see the module docstring).
+# The τ search runs on θ = τ·σ_max(E)² in [LFT_THETA_MIN, LFT_THETA_MAX]: near θ = 1 the
+# weight 1/(1 − θ) of the worst direction, near θ = 0 the weight 1/τ of ‖HT‖², make the
+# T-step ill-conditioned (at θ = 1e-12 the box QP's pivots dropped B₀ altogether and
+# returned T = 0). φ is convex, so stopping at an end costs at most |φ'|·(distance to the
+# interval's end) of the squared worst case: the "hard case" τ* = 1/σ_max² at the top, an
+# optimum with HT = 0 (τ* → 0) at the bottom, where the refinement then solves the
+# weighted least squares with weight 1e6 on HT.
+LFT_THETA_MIN = 1e-6
 LFT_THETA_MAX = 1.0 - 1e-6
 
 _SOURCE = "RobustLftParams"
@@ -116,7 +146,9 @@ class RobustLftParams:
         rho: uncertainty size ρ ≥ 0 scaling ``E = ρ E_shape`` (default 0.1).
         e_shape: ``E_shape`` (m×p rows), None = the m×m identity.
         h_matrix: ``H`` (p'×n rows, over all n thrusters), None = ``diag(‖B₀ e_j‖)``.
-        regularization: ε relative to the mean diagonal of ``B₀ᵀB₀`` (≥ 0).
+        regularization: the τ search's ridge ε relative to the mean diagonal of ``B₀ᵀB₀``,
+            within :data:`LFT_REGULARIZATION_RANGE` (refined away: the answer is the
+            unregularised optimum).
         max_iter: bound on the τ-search evaluations (inner box QPs) per allocation (≥ 1).
         warm_start: start from the previous call's τ and active set (deterministic).
     """
@@ -134,7 +166,15 @@ class RobustLftParams:
         check_bound_spec(_SOURCE, "upper_N", self.upper_N)
         check_bound_spec(_SOURCE, "lower_N", self.lower_N)
         check.non_negative(_SOURCE, "rho", self.rho)
-        check.non_negative(_SOURCE, "regularization", self.regularization)
+        low, high = LFT_REGULARIZATION_RANGE
+        if not low <= self.regularization <= high:
+            raise ConfigError(
+                _SOURCE, "regularization", self.regularization,
+                f"a ridge in [{low:g}, {high:g}]: the answer is refined to the unregularised "
+                "optimum, which is exact only in that range (below it the S-lemma inner "
+                "matrix is numerically singular near the hard case; above it the ridge moves "
+                "the active set)",
+            )  # fmt: skip
         for key in ("e_shape", "h_matrix"):
             value = getattr(self, key)
             if value is not None and not isinstance(value, tuple):
@@ -255,9 +295,17 @@ class RobustLftAllocator(ControlAllocation):
             self._state[:] = FREE
         theta0 = self._theta_warm if math.isfinite(self._theta_warm) else LFT_THETA_START
         self._theta_warm = monotone_root(
-            evaluate, theta0, THETA_MIN, LFT_THETA_MAX, self._params.max_iter
+            evaluate, theta0, LFT_THETA_MIN, LFT_THETA_MAX, self._params.max_iter
         )
-        return best[0][1]
+        return self._refined(best[0][1], self._theta_warm / s_max, cv)
+
+    def _refined(self, t: np.ndarray, tau: float, cv: np.ndarray) -> np.ndarray:
+        """The ε → 0 least-norm minimiser of ``f(·, τ)`` on the active set of ``t``, when it
+        does not raise the unregularised ``f(·, τ)`` (step 3 of the module docstring)."""
+        root_d = np.sqrt(1.0 / (1.0 - tau * self._eig_s))
+        b_w = np.vstack((root_d[:, None] * self._c_mat, self._h_a / math.sqrt(tau)))
+        d_w = np.concatenate((root_d * cv, np.zeros(self._h_a.shape[0])))
+        return refine(b_w, d_w, t, self._lo_a, self._hi_a, self._attained_tol**2)
 
     def _solve(self, d: np.ndarray) -> tuple[np.ndarray, bool | None]:
         t_a = self._robust(d)

@@ -95,3 +95,25 @@ def test_allocator_contract(
     assert zero.residual_norm <= ACHIEVED_TOL and not zero.saturated
     bad = alloc.allocate(np.full(b.shape[0], np.nan))
     assert np.all(bad.thrust_N == 0.0) and bad.saturated and bad.residual_norm == np.inf
+
+
+@pytest.mark.parametrize("kind", sorted(FACTORIES))
+@pytest.mark.parametrize("which", ["b8", "b16"])
+def test_warm_up_leaves_results_unchanged(
+    kind: str, which: str, request: pytest.FixtureRequest
+) -> None:
+    """A warmed-up allocator (and a masked one) returns bit-identical thrusts to a cold one."""
+    b: np.ndarray = request.getfixturevalue(which)
+    rng = np.random.default_rng(11)
+    scale = float(np.abs(b).max()) * T_MAX_N
+    demands = [rng.normal(size=b.shape[0]) * scale * s for s in (0.1, 1.0, 10.0) for _ in range(3)]
+    mask = np.ones(b.shape[1], dtype=bool)
+    mask[MASKED_THRUSTER] = False
+    for m in (None, mask):
+        cold = FACTORIES[kind](b, T_MAX_N)
+        warm = FACTORIES[kind](b, T_MAX_N)
+        if m is not None:
+            cold, warm = cold.with_mask(m), warm.with_mask(m)
+        warm.warm_up()
+        for d in demands:
+            assert np.array_equal(warm.allocate(d).thrust_N, cold.allocate(d).thrust_N)
