@@ -50,6 +50,7 @@ SUMMARY_KEYS = (
     "propellant_kg",
     "valve_openings",
     "final_position_error_m",
+    "net_translation",
     "realtime_factor",
 )
 
@@ -153,6 +154,8 @@ def figures(summary: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     out["failed_expectations"] = [
         e for e in summary.get("expectations", []) if isinstance(e, dict) and not e.get("pass")
     ]
+    if "error" not in summary:
+        out["hold"] = hold_figures(run_dir, summary)
     stats_path = run_dir / "fsw_stats.json"
     if stats_path.exists():
         stats = json.loads(stats_path.read_text(encoding="utf-8"))
@@ -162,6 +165,29 @@ def figures(summary: dict[str, Any], run_dir: Path) -> dict[str, Any]:
     if "error" in summary:
         out["error"] = summary["error"]
     return out
+
+
+def hold_figures(run_dir: Path, summary: dict[str, Any]) -> dict[str, Any] | None:
+    """Valve activity and propellant once converged: from the later of the attitude and
+    position settling times to the end (None if the run never settled): valve pulses per
+    second (all thrusters), propellant [kg] and its fraction of the run's total."""
+    settled = [summary.get(k) for k in ("settling_time_s", "position_settling_time_s")]
+    if summary.get("settling_time_s") is None:
+        return None
+    t_from = max(t for t in settled if t is not None)
+    tel = read_telemetry(run_dir)
+    t, prop = tel["t_s"], tel["propellant_kg"]
+    total = float(prop[-1])
+    used = total - float(np.interp(t_from, t, prop))
+    pulse_rows = csv.DictReader(read_lines(run_file(run_dir, "valve_pulses.csv")))
+    n_hold = sum(1 for r in pulse_rows if float(r["t_on_s"]) >= t_from)
+    span = float(t[-1]) - t_from
+    return {
+        "from_s": t_from,
+        "pulses_per_s": n_hold / span if span > 0 else None,
+        "propellant_kg": used,
+        "propellant_fraction": used / total if total > 0 else None,
+    }
 
 
 def read_telemetry(run_dir: Path) -> dict[str, np.ndarray]:

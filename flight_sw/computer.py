@@ -12,8 +12,10 @@ Chain (seed 003's architecture, extended to 6 DoF after seed 000): estimator (gy
 propagation + star-tracker correction) -> attitude controller (torque demand, body axes,
 N m) and, when a translation controller is configured, translation controller (force
 demand, body axes, N, from the navigation solution rotated with the estimated attitude)
--> allocator (thrust per thruster, N, bounded to [0, Tmax]; 3 torque rows, or 6 wrench
-rows in 6 DoF) -> one modulator per thruster (demanded fraction -> on-time).
+-> allocator (thrust per thruster, N, bounded to [0, Tmax]; the 6 wrench rows in 6 DoF,
+and in attitude-only control too when ``pure_torque`` (the torque with a zero force
+demand, so the thrusters fire in force-free sets), else the 3 torque rows) -> one
+modulator per thruster (demanded fraction -> on-time).
 
 FDIR (docs/fdir.md):
 - Safe mode: IMU_RATE silent for 3 of its periods latches SAFE: every valve closed. A
@@ -118,6 +120,7 @@ class FlightComputer:
     nav_timeout_ns: int = DEFAULT_NAV_TIMEOUT_NS
     guidance: AttitudeGuidance | None = None  # a moving reference (else the Timeline's step)
     pose: PoseController | None = None  # a coupled 6-DoF law (replaces both controllers)
+    pure_torque: bool = False  # attitude-only: allocate (0 N, torque) on the wrench rows
     inertia_id: InertiaIdentifier | None = None
     # realtime: each cycle starts this long after one of the bench's control instants
     cycle_phase_ns: int = DEFAULT_CYCLE_PHASE_NS
@@ -350,6 +353,8 @@ class FlightComputer:
                 if nav is not None:
                     force = self.translation.force_B_N(t_ns, est.q_BN, r, v, r_ref, np.zeros(3))
                 demand = np.concatenate((force, torque))
+            elif self.pure_torque:
+                demand = np.concatenate((force, torque))  # zero force: couples only
             else:
                 demand = torque
         if fdir is not None and self.effectiveness is not None:

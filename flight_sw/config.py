@@ -36,7 +36,7 @@ from dbc.contract import FswConfig
 from dbc.datafile import parse_json, read_text
 from dbc.errors import ConfigError
 from dbc.schema import Table
-from flight_sw.allocation.authority import authority_warnings
+from flight_sw.allocation.authority import authority_warnings, force_free_torque_unreached
 from flight_sw.allocation.base import Allocator
 from flight_sw.builders.allocation import ALLOCATORS
 from flight_sw.builders.control import CONTROLLERS, POSE_CONTROLLERS, TRANSLATION_CONTROLLERS
@@ -106,6 +106,38 @@ def _strategy(parent: Table, key: str, registry: Mapping[str, Any], v: Vehicle) 
     t = parent.table(key)
     kind = t.string("kind", choices=tuple(registry))
     return _build(t, registry[kind], v)
+
+
+def _pure_torque(fsw: Table, v: Vehicle, attitude_only: bool) -> tuple[bool, tuple[str, ...]]:
+    """Whether attitude-only control allocates the wrench with zero force, and a warning.
+
+    ``[flight_sw] pure_torque`` (default true): an attitude-only controller's torque is
+    allocated on the 6 wrench rows with a zero force demand, so the thrusters fire in
+    force-free sets (couples) and an attitude manoeuvre leaves no net ΔV; with torque rows
+    only, the allocator may meet a torque with thrusters whose forces add (on seed 003's
+    layout, diagonal pairs: 0.12 m/s over 60 s). When the layout cannot give some torque
+    axis without force, the torque rows are used and the statistics say which axes.
+    Ignored (must be absent or true) with a 6-DoF or translation controller, which
+    allocate the wrench already.
+    """
+    if not fsw.has("pure_torque"):
+        wanted = True
+    else:
+        wanted = fsw.flag("pure_torque")
+        if wanted is False and not attitude_only:
+            raise fsw.error("pure_torque", False, "absent or true: the 6-DoF controller "
+                            "allocates force and torque together")
+    if not (wanted and attitude_only):
+        return False, ()
+    missing = force_free_torque_unreached(v.effectiveness)
+    if missing:
+        return False, (
+            f"pure_torque: the {v.effectiveness.shape[1]} thrusters cannot produce torque "
+            f"about {', '.join(missing)} without a net force, so attitude-only firing is "
+            "allocated on the torque rows alone and will translate the vehicle "
+            "(net_translation in summary.json)",
+        )
+    return True, ()
 
 
 def _thruster_fdir(parent: Table, v: Vehicle) -> tuple[ThrusterFdir | None, bool]:
@@ -184,6 +216,9 @@ def build_computer(
     if fsw.has("translation"):
         translation, r_target = _strategy(fsw, "translation", TRANSLATION_CONTROLLERS, vehicle)
         vehicle.demand_rows = WRENCH_ROWS
+    pure_torque, pure_torque_note = _pure_torque(fsw, vehicle, pose is None and translation is None)
+    if pure_torque:
+        vehicle.demand_rows = WRENCH_ROWS  # the torque demand with zero force
     allocator = _strategy(fsw, "allocator", ALLOCATORS, vehicle)
     make_modulator = _strategy(fsw, "modulator", MODULATORS, vehicle)
     inertia_id = (
@@ -237,8 +272,14 @@ def build_computer(
         inertia_id=inertia_id,
         pose=pose,
         cycle_phase_ns=round(phase_s * NS_PER_S),
-        warnings=tuple(authority_warnings(vehicle.effectiveness,
-                                          controls_force=vehicle.demand_rows == WRENCH_ROWS)),
+        pure_torque=pure_torque,
+        warnings=(
+            *authority_warnings(
+                vehicle.effectiveness,
+                controls_force=vehicle.demand_rows == WRENCH_ROWS and not pure_torque,
+            ),
+            *pure_torque_note,
+        ),
     )
 
 

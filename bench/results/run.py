@@ -142,14 +142,15 @@ class Results:
             "wall_clock_origin_s": self.wall_origin_s,
             "realtime_factor": round(sim_time_s / self.wall_s, 2) if self.wall_s > 0 else None,
         }
-        out.update(expectations_and_metrics(sc, self.telemetry.errors))
+        moved = net_translation(sc, tuple(station.plant.state[7:10]),
+                                tuple(station.plant.state[10:13]))
+        out.update(expectations_and_metrics(sc, self.telemetry.errors, moved["delta_v_m_s"]))
         out.update({
             "reference_kind": sc.reference.kind,
             "translation": sc.dynamics.translation,
             "valve_model": sc.valve.model,
             "events": station.captures,
-            "net_translation": net_translation(sc, tuple(station.plant.state[7:10]),
-                                               tuple(station.plant.state[10:13])),
+            "net_translation": moved,
             "propellant_kg": thr.total_propellant_kg,
             "valve_openings": {"total": int(sum(thr.openings)),
                                "per_thruster": list(thr.openings)},

@@ -19,7 +19,8 @@ from bench.results.metrics import expectation, settling_expectation
 from bench.scenario.spec import Scenario
 
 
-def expectations_and_metrics(sc: Scenario, errors: ErrorStats) -> dict[str, Any]:
+def expectations_and_metrics(sc: Scenario, errors: ErrorStats,
+                             net_delta_v_m_s: float) -> dict[str, Any]:
     """Convergence, settling, steady-state errors and the expectations (module docstring)."""
     e = sc.expectations
     pm = errors.pointing()
@@ -42,6 +43,7 @@ def expectations_and_metrics(sc: Scenario, errors: ErrorStats) -> dict[str, Any]
         expectation("steady_state_position_error_m", pos_ss,
                     e.steady_state_position_error_m_max),
         expectation("final_position_error_m", pos_final, e.final_position_error_m_max),
+        expectation("net_delta_v_m_s", net_delta_v_m_s, e.net_delta_v_m_s_max),
         settling_expectation("position_settling_time_s", pos_settling,
                              e.position_settling_time_s_max, e.position_band_m, "m"),
     )
@@ -72,8 +74,9 @@ def _with_requirement(row: dict[str, Any], req: str | None) -> dict[str, Any]:
 def net_translation(sc: Scenario, r_end_N_m: tuple[float, ...],
                     v_end_N_m_s: tuple[float, ...]) -> dict[str, Any]:
     """How far the vehicle moved and how much its velocity changed over the run [m], [m/s]
-    (the net effect of the firing and the disturbances: in an attitude-only run the halves
-    of a thruster couple act at different instants, so they do not cancel exactly)."""
+    (the net effect of the firing and the disturbances; in an attitude-only run, what the
+    force-free thruster sets of ``pure_torque`` leave: each thruster's modulator rounds its
+    own on-time, and the halves of a set may travel in different command frames)."""
     return {
         "displacement_m": math.dist(r_end_N_m, sc.r0_N_m),
         "delta_v_m_s": math.dist(v_end_N_m_s, sc.v0_N_m_s),

@@ -67,6 +67,7 @@ def parse_expectations(et: Table, duration_s: float) -> Expectations:
         rate_settling_band_deg_s=et.number("rate_settling_band_deg_s", lo=0.0, lo_open=True)
         if et.has("rate_settling_band_deg_s") else None,
         rate_settling_time_s_max=_limit(et, "rate_settling_time_s_max", reqs),
+        net_delta_v_m_s_max=_limit(et, "net_delta_v_m_s_max", reqs),
         steady_state_window_s=et.number(
             "steady_state_window_s", 10.0, lo=0.0, lo_open=True, hi=duration_s
         ),

@@ -156,6 +156,7 @@ class Expectations:
     position_settling_time_s_max: float | None = None
     rate_settling_band_deg_s: float | None = None
     rate_settling_time_s_max: float | None = None
+    net_delta_v_m_s_max: float | None = None  # |v_end − v0| the firing may leave [m/s]
     # (expectation row name, requirement ID) pairs: "settling_time_s", ..., "converged"
     requirements: tuple[tuple[str, str], ...] = ()
 

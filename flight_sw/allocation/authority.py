@@ -3,7 +3,9 @@
 What it does: from the effectiveness matrix ``B`` (columns ``[d; r × d]``: force [N] and
 torque [N m] per newton of each thruster, flight_sw.allocation.effectiveness), for each
 signed body axis ±x, ±y, ±z of the torque (and of the force, when this flight software
-controls translation too) whether some thrusts ``T ≥ 0`` produce it: the least
+controls translation too) whether some thrusts ``T ≥ 0`` produce it — and, for
+attitude-only control, whether they produce each torque with zero net force
+(:func:`force_free_torque_unreached`) — : the least
 absolute residual of ``B T = ±e_i`` over ``T ≥ 0`` (a linear programme with slacks
 ``B T + s⁺ − s⁻ = ±e_i``, minimising ``Σ s``; HiGHS, flight_sw.allocation.linear_program)
 is zero to round-off exactly when the axis lies in the cone of the columns (Lawson &
@@ -37,16 +39,24 @@ def _cone_residual(rows: np.ndarray, target: np.ndarray) -> float:
     return float(np.linalg.norm(rows @ np.maximum(x[:n], 0.0) - target))
 
 
-def unreached_axes(rows: np.ndarray) -> list[str]:
-    """The signed axes (``+x`` ... ``-z``) of ``rows`` (3 × n) no thrusts ``T ≥ 0`` give."""
+def unreached_axes(rows: np.ndarray, first: int = 0) -> list[str]:
+    """The signed axes (``+x`` ... ``-z``) no thrusts ``T ≥ 0`` give: ``rows`` (m × n) times
+    ``T`` must equal the unit vector along rows ``first``…``first + 2``, the other rows 0."""
     out = []
     for i, axis in enumerate(AXES):
         for sign in (1.0, -1.0):
-            target = np.zeros(3)
-            target[i] = sign
+            target = np.zeros(rows.shape[0])
+            target[first + i] = sign
             if _cone_residual(rows, target) > REACH_TOL:
                 out.append(f"{'+' if sign > 0 else '-'}{axis}")
     return out
+
+
+def force_free_torque_unreached(b: np.ndarray) -> list[str]:
+    """The signed torque axes the thrusters of the 6 × n ``b`` cannot give with zero net
+    force (no ``T ≥ 0`` with ``B_F T = 0`` and ``B_τ T = ±e``): where attitude-only firing
+    must translate the vehicle."""
+    return unreached_axes(b, first=3)
 
 
 def authority_warnings(b: np.ndarray, controls_force: bool) -> list[str]:

@@ -42,6 +42,13 @@ Static characteristic (constant ``u``, after the transient; the min-on rule igno
   duty cycle ``T_on/(T_on + T_off)``, pulse frequency ``1/(T_on + T_off)``;
 - minimum pulse (at the dead-zone edge ``K_m u = U_on``): ``Δ_min = −T_m ln(1 − h/K_m)``.
 
+Design rule (measured on the seed-003 vehicle with sensor noise, on-off valves with a
+5 ms minimum on-time; ``benchmarks/pwpf_trade.py``, docs/reproductions.md): the dead zone
+``U_on/K_m`` sets the pointing of the hold (1 % of full thrust: 0.016°; 0.5 %: 0.013°), and
+halving it costs about 1.5× the hold's propellant; ``h`` matters little while the minimum
+pulse above is shorter than the valves' minimum on-time (the rounding rule then shapes
+the limit cycle). Defaults of the scenarios: K_m 20, T_m 0.1 s, U_on 0.2, U_off 0.1.
+
 Inputs/outputs: ``u`` thrust fraction (dimensionless; clipped to [0, 1], NaN → 0), ``period_s``
 [s], on-time [s]; parameters ``km`` (dimensionless), ``tm_s`` [s], ``u_on``, ``u_off``
 (dimensionless, filter-output units), ``min_on_s`` [s].

@@ -6,6 +6,7 @@ import copy
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from bench.scenario.load import load_scenario
@@ -75,3 +76,46 @@ def test_every_consumer_gets_each_thrusters_maximum() -> None:
     assert isinstance(fc.allocator, PseudoInverseAllocator)
     assert fc.allocator.bounds_N[1].tolist() == expected
     assert fc.max_thrust_N.tolist() == expected
+
+
+FORCE_FREE_ATOL_N = 1e-9  # net force of a pure-torque allocation (round-off) [N]
+PURE_TORQUE_DEMAND_NM = 2.0  # scale of the random torque demands (inside the authority) [N m]
+
+
+def test_attitude_only_allocates_torque_with_zero_force(cfg: dict[str, Any]) -> None:
+    """Quickstart (attitude only): the allocator gets the 6 wrench rows and its thrusts for
+    a torque demand with zero force give that torque and no net force."""
+    fc = build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert fc.pure_torque and fc.allocator.effectiveness.shape == (6, 8)  # type: ignore[attr-defined]
+    b = fc.allocator.effectiveness  # type: ignore[attr-defined]
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        torque = rng.normal(size=3) * PURE_TORQUE_DEMAND_NM
+        res = fc.allocator.allocate(np.concatenate((np.zeros(3), torque)))
+        assert np.linalg.norm(b[:3] @ res.thrust_N) <= FORCE_FREE_ATOL_N
+        assert not res.saturated and res.residual_norm <= FORCE_FREE_ATOL_N
+
+
+def test_pure_torque_false_allocates_the_torque_rows_only(cfg: dict[str, Any]) -> None:
+    """pure_torque = false: the 3 torque rows (the seed papers' allocation)."""
+    cfg["flight_sw"]["pure_torque"] = False
+    fc = build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert not fc.pure_torque and fc.allocator.effectiveness.shape == (3, 8)  # type: ignore[attr-defined]
+
+
+def test_layout_without_force_free_torque_is_warned(cfg: dict[str, Any]) -> None:
+    """Thruster 0 removed: +z torque needs a net force, so the torque rows are used and
+    the statistics' warnings name the axis."""
+    del cfg["thrusters"][0]
+    fc = build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert not fc.pure_torque and fc.allocator.effectiveness.shape == (3, 7)  # type: ignore[attr-defined]
+    assert any("pure_torque" in w and "+z" in w for w in fc.warnings)
+
+
+def test_pure_torque_false_with_a_6dof_law_is_refused() -> None:
+    """The 6-DoF NFTSM allocates the wrench already: pure_torque = false is named an error."""
+    cfg = load_scenario(QUICKSTART.parent / "formation_keeping_nftsm.toml").fsw_config()
+    cfg["flight_sw"]["pure_torque"] = False
+    with pytest.raises(ConfigError) as info:
+        build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert info.value.key == "flight_sw.pure_torque"

@@ -50,10 +50,11 @@ def test_fdir_16thr_builds_a_6dof_computer_with_both_fdir_strategies(
 
 
 def test_quickstart_stays_attitude_only_without_fdir() -> None:
-    """No translation or thruster_fdir table: 3 torque rows, no thruster FDIR."""
+    """No translation or thruster_fdir table: attitude only (pure torque: the 6 wrench rows
+    with a zero force demand), no thruster FDIR."""
     fc = build_computer(load_scenario(QUICKSTART).fsw_config(), PERIOD_NS, IMU_NS, WATCH)
-    assert fc.translation is None and fc.thruster_fdir is None
-    assert fc.effectiveness is not None and fc.effectiveness.shape == (3, 8)
+    assert fc.translation is None and fc.thruster_fdir is None and fc.pure_torque
+    assert fc.effectiveness is not None and fc.effectiveness.shape == (6, 8)
 
 
 def test_single_failure_allocators_are_precomputed() -> None:
@@ -64,7 +65,7 @@ def test_single_failure_allocators_are_precomputed() -> None:
     assert len(fc.allocators_by_mask) == 8
     for mask, alloc in fc.allocators_by_mask.items():
         failed = mask.index(False)
-        assert alloc.allocate(np.array([0.5, -0.2, 0.1])).thrust_N[failed] == 0.0
+        assert alloc.allocate(np.array([0.0, 0.0, 0.0, 0.5, -0.2, 0.1])).thrust_N[failed] == 0.0
 
 
 @pytest.mark.parametrize(

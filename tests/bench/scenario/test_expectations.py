@@ -52,3 +52,25 @@ def test_inline_limit_takes_only_max_and_req() -> None:
         load_scenario(QUICKSTART, ['expectations.settling_time_s_max={max=7.5, reqq="R-1"}'])
     with pytest.raises(ConfigError, match=r"expectations\.settling_time_s_max\.max"):
         load_scenario(QUICKSTART, ['expectations.settling_time_s_max={req="R-1"}'])
+
+
+NET_DV_LIMIT_M_S = 0.005
+
+
+def test_net_delta_v_limit_becomes_an_expectation_row() -> None:
+    """net_delta_v_m_s_max: a row with the run's delta-v, its limit and pass/fail (above it
+    fails), named like the summary's net_translation.delta_v_m_s; negative refused."""
+    from bench.results.error_stats import ErrorStats
+    from bench.results.summary import expectations_and_metrics
+
+    sc = load_scenario(QUICKSTART, [f"expectations.net_delta_v_m_s_max={NET_DV_LIMIT_M_S}"])
+    assert sc.expectations.net_delta_v_m_s_max == NET_DV_LIMIT_M_S
+    errors = ErrorStats(sc.expectations.settling_band_deg, sc.expectations.steady_state_window_s,
+                        0.0)
+    errors.add(0.0, 0.0, 0.0, 0.0)
+    for dv, ok in ((0.5 * NET_DV_LIMIT_M_S, True), (2.0 * NET_DV_LIMIT_M_S, False)):
+        rows = expectations_and_metrics(sc, errors, dv)["expectations"]
+        (row,) = [r for r in rows if r["name"] == "net_delta_v_m_s"]
+        assert row["value"] == dv and row["max"] == NET_DV_LIMIT_M_S and row["pass"] is ok
+    with pytest.raises(ConfigError, match=r"expectations\.net_delta_v_m_s_max"):
+        load_scenario(QUICKSTART, ["expectations.net_delta_v_m_s_max=-1.0"])

@@ -7,7 +7,12 @@ from pathlib import Path
 import numpy as np
 
 from bench.scenario.load import load_scenario
-from flight_sw.allocation.authority import REACH_TOL, authority_warnings, unreached_axes
+from flight_sw.allocation.authority import (
+    REACH_TOL,
+    authority_warnings,
+    force_free_torque_unreached,
+    unreached_axes,
+)
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 
 QUICKSTART = Path(__file__).resolve().parents[3] / "scenarios" / "quickstart.toml"
@@ -59,3 +64,40 @@ def test_cone_test_agrees_with_nonnegative_least_squares() -> None:
                 if nnls(rows, target)[1] > REACH_TOL:
                     expected.append(f"{'+' if sign > 0 else '-'}{axis}")
         assert unreached_axes(rows) == expected
+
+
+def _quickstart_b() -> np.ndarray:
+    sc = load_scenario(QUICKSTART)
+    return effectiveness_matrix(np.array([t.r_thr_B_m for t in sc.thrusters]),
+                                np.array([t.d_thr_B for t in sc.thrusters]))
+
+
+def test_seed003_set_gives_every_torque_without_force() -> None:
+    """The quickstart's 8 thrusters make each signed torque from force-free sets."""
+    assert force_free_torque_unreached(_quickstart_b()) == []
+
+
+def test_losing_one_thruster_leaves_a_torque_only_with_force() -> None:
+    """Without thruster 0 (+y at +x): +z torque still reachable, but only with a net force
+    (its force-free partner sets all need it), so only the force-free test names +z."""
+    b = np.delete(_quickstart_b(), 0, axis=1)
+    assert unreached_axes(b[3:]) == []
+    assert force_free_torque_unreached(b) == ["+z"]
+
+
+def test_force_free_test_agrees_with_nonnegative_least_squares() -> None:
+    """Random 6 × n sets: a torque axis is unreached without force exactly when NNLS of
+    B T = (0, ±e) leaves a residual (scipy's nnls, the reference)."""
+    from scipy.optimize import nnls
+
+    rng = np.random.default_rng(13)
+    for _ in range(40):
+        b = rng.normal(size=(6, int(rng.integers(4, 12))))
+        expected = []
+        for i, axis in enumerate("xyz"):
+            for sign in (1.0, -1.0):
+                target = np.zeros(6)
+                target[3 + i] = sign
+                if nnls(b, target)[1] > REACH_TOL:
+                    expected.append(f"{'+' if sign > 0 else '-'}{axis}")
+        assert force_free_torque_unreached(b) == expected
