@@ -22,6 +22,12 @@ Optional tables of ``flight_sw`` (issue 4):
   cycle; ≈ 0.2 s each for 16 thrusters and 6 rows).
 - ``sensor_fdir`` (``kind`` from :data:`SENSOR_FDIR`): frozen-sensor counts; defaults
   apply when absent.
+- ``fine_hold`` (with a 6-DoF ``controller`` only): the thresholds of
+  :class:`flight_sw.control.fine_hold.FineHoldParams` and the fine laws ``attitude`` (a
+  ``kind`` of :data:`CONTROLLERS`) and ``translation`` (``position_pd``) that take over
+  near the target (:mod:`flight_sw.control.fine_hold`).
+- ``pure_torque`` (default true): attitude-only control allocates the torque with zero
+  force on the 6 wrench rows (:func:`_pure_torque`).
 """
 
 from __future__ import annotations
@@ -44,7 +50,7 @@ from flight_sw.builders.estimation import ESTIMATORS, INERTIA_IDENTIFIERS
 from flight_sw.builders.fdir import SENSOR_FDIR, THRUSTER_FDIR
 from flight_sw.builders.guidance import GUIDANCE
 from flight_sw.builders.modulation import MODULATORS
-from flight_sw.builders.vehicle import NS_PER_S, WRENCH_ROWS, Vehicle
+from flight_sw.builders.vehicle import NS_PER_S, WRENCH_ROWS, Vehicle, dataclass_params
 from flight_sw.computer import (
     DEFAULT_CYCLE_PHASE_NS,
     DEFAULT_NAV_TIMEOUT_NS,
@@ -106,6 +112,21 @@ def _strategy(parent: Table, key: str, registry: Mapping[str, Any], v: Vehicle) 
     t = parent.table(key)
     kind = t.string("kind", choices=tuple(registry))
     return _build(t, registry[kind], v)
+
+
+def _fine_hold(t: Table, coarse: PoseController, v: Vehicle) -> PoseController:
+    """``[flight_sw.fine_hold]``: the thresholds of :class:`FineHoldParams` and the fine
+    laws, ``attitude`` (an attitude ``kind``) and ``translation`` (``position_pd``)."""
+    from flight_sw.control.fine_hold import FineHold, FineHoldParams
+
+    attitude = _strategy(t, "attitude", CONTROLLERS, v)
+    translation, r_target = _strategy(t, "translation", TRANSLATION_CONTROLLERS, v)
+    if r_target is not None:
+        raise t.error("translation.r_target_N_m", r_target.tolist(), "absent: the fine hold "
+                      "holds the manoeuvre's target")
+    params = dataclass_params(t, FineHoldParams, {})
+    t.done()
+    return FineHold(coarse, attitude, translation, params)
 
 
 def _pure_torque(fsw: Table, v: Vehicle, attitude_only: bool) -> tuple[bool, tuple[str, ...]]:
@@ -201,6 +222,8 @@ def build_computer(
     pose: PoseController | None = None
     if ctl.string("kind", choices=(*CONTROLLERS, *POSE_CONTROLLERS)) in POSE_CONTROLLERS:
         pose = _strategy(fsw, "controller", POSE_CONTROLLERS, vehicle)
+        if fsw.has("fine_hold"):
+            pose = _fine_hold(fsw.table("fine_hold"), pose, vehicle)
         controller: AttitudeController = _NoAttitudeLaw()
         vehicle.demand_rows = WRENCH_ROWS
         if fsw.has("translation"):
@@ -212,6 +235,10 @@ def build_computer(
             )
     else:
         controller = _strategy(fsw, "controller", CONTROLLERS, vehicle)
+        if fsw.has("fine_hold"):
+            raise fsw.error("fine_hold", fsw.raw("fine_hold"), "no fine_hold table: it hands "
+                            "a 6-DoF controller (nftsm_dq, tsm_dq) over to PD laws near the "
+                            "target")
     translation, r_target = None, None
     if fsw.has("translation"):
         translation, r_target = _strategy(fsw, "translation", TRANSLATION_CONTROLLERS, vehicle)

@@ -19,6 +19,7 @@ from typing import Any
 from dbc.contract import STATS_SCHEMA, VERSION
 from dbc.records import percentile_summary
 from flight_sw.computer import CycleResult, FlightComputer
+from flight_sw.control.fine_hold import FineHold
 
 NS_PER_US = 1e3
 NS_PER_S = 1e9
@@ -103,6 +104,8 @@ def stats_record(st: NodeStats, received: dict[str, dict[str, Any]], fc: FlightC
         "allocation": {"residual_torque_Nm": spread(st.residual_Nm),
                        "residual_force_N": spread(st.residual_N),
                        "saturated_cycles": st.saturated_cycles, "cycles": st.cycles},
+        "fine_hold": None if not isinstance(fc.pose, FineHold) else {
+            "active": fc.pose.in_fine_hold, "switches": fc.pose.switches},
         "inertia_estimate_B_kgm2": (
             None if fc.inertia_B_kgm2 is None else fc.inertia_B_kgm2.tolist()),
         "restarts": st.restarts,

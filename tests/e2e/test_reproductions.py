@@ -23,6 +23,10 @@ TENFOLD = 10.0  # issue 3: at least 10x better than the paper's bound
 SEED001_INERTIA_KGM2 = np.array([[25.0, 0.8, -0.5], [0.8, 20.0, 0.6], [-0.5, 0.6, 15.0]])
 INERTIA_REL_TOL = 0.05  # identified principal moments within 5 % of the truth
 THRUST_TOL_N = 1e-9
+# Issue 24, seed 000 hold (after the later of attitude and position settling): valve
+# pulses per second over all 16 thrusters, and the fraction of the run's propellant.
+HOLD_PULSES_MAX_PER_S = 20.0
+HOLD_PROPELLANT_FRACTION_MAX = 0.10
 # Issue 24: an attitude-only manoeuvre on couples leaves at most 5 mm/s (pure torque).
 PURE_TORQUE_DV_MAX_M_S = 0.005
 SEED003_FINE_POINTING_DEG = 0.02  # issue 24: steady state with sensor noise, on-off valves
@@ -77,11 +81,28 @@ def test_attitude_only_manoeuvre_leaves_no_net_delta_v(
         assert dv > 10.0 * PURE_TORQUE_DV_MAX_M_S
 
 
+def _hold(summary: dict[str, Any], run_dir: Path) -> tuple[float, float]:
+    """(valve pulses per second, fraction of the propellant) after settling."""
+    t_from = max(summary["settling_time_s"], summary["position_settling_time_s"])
+    with io.StringIO(run_text(run_dir, "valve_pulses.csv"), newline="") as f:
+        n = sum(1 for r in csv.DictReader(f) if float(r["t_on_s"]) >= t_from)
+    with io.StringIO(run_text(run_dir, "telemetry.csv"), newline="") as f:
+        tel = [(float(r["t_s"]), float(r["propellant_kg"])) for r in csv.DictReader(f)]
+    at_settling = next(p for t, p in tel if t >= t_from)
+    total = tel[-1][1]
+    return n / (tel[-1][0] - t_from), (total - at_settling) / total
+
+
 def test_seed000_formation_keeping_nftsm_beats_tsm(tmp_path: Path, runtime_dir: Path) -> None:
-    """Seed 000: NFTSM meets its expectations within 5 N per thruster and converges before TSM."""
+    """Seed 000: NFTSM meets its expectations within 5 N per thruster, holds without
+    chatter (fine hold: ≤ 20 pulses/s, ≤ 10 % of the propellant after settling) and
+    converges before TSM."""
     nftsm, out = _run("formation_keeping_nftsm", tmp_path, runtime_dir)
     assert nftsm["passed"], _failed(nftsm)
     assert _max_thrust_N(out) <= SEED000_MAX_THRUST_N + THRUST_TOL_N
+    pulses_per_s, fraction = _hold(nftsm, out)
+    assert pulses_per_s <= HOLD_PULSES_MAX_PER_S
+    assert fraction <= HOLD_PROPELLANT_FRACTION_MAX
     tsm, _ = _run("formation_keeping_nftsm", tmp_path / "tsm", runtime_dir,
                   "--set", "flight_sw.controller={kind='tsm_dq'}")
     assert tsm["position_settling_time_s"] > nftsm["position_settling_time_s"]

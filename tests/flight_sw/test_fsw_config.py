@@ -119,3 +119,30 @@ def test_pure_torque_false_with_a_6dof_law_is_refused() -> None:
     with pytest.raises(ConfigError) as info:
         build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
     assert info.value.key == "flight_sw.pure_torque"
+
+
+def test_seed000_scenario_builds_a_fine_hold() -> None:
+    """formation_keeping_nftsm: the NFTSM wrapped in a fine hold with the scenario's PD pair."""
+    from flight_sw.control.fine_hold import FineHold
+    from flight_sw.control.nftsm_dq import NftsmDq
+
+    cfg = load_scenario(QUICKSTART.parent / "formation_keeping_nftsm.toml").fsw_config()
+    fc = build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert isinstance(fc.pose, FineHold) and isinstance(fc.pose.coarse, NftsmDq)
+    assert fc.pose.params.leave_position_m == cfg["flight_sw"]["fine_hold"]["leave_position_m"]
+
+
+def test_fine_hold_with_an_attitude_only_law_is_refused(cfg: dict[str, Any]) -> None:
+    """A fine_hold table beside an attitude controller is named an error."""
+    cfg["flight_sw"]["fine_hold"] = {}
+    with pytest.raises(ConfigError) as info:
+        build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
+    assert info.value.key == "flight_sw.fine_hold"
+
+
+def test_fine_hold_misspelt_threshold_is_refused() -> None:
+    """An unknown key in the fine_hold table is an error, not a silent default."""
+    cfg = load_scenario(QUICKSTART.parent / "formation_keeping_nftsm.toml").fsw_config()
+    cfg["flight_sw"]["fine_hold"]["enter_positon_m"] = 0.1
+    with pytest.raises(ConfigError, match="enter_positon_m"):
+        build_computer(cfg, PERIOD_NS, IMU_NS, WATCH)
