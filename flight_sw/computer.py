@@ -376,7 +376,7 @@ class FlightComputer:
             self._torque_applied_B_Nm = self.effectiveness[-TORQUE_DIM:] @ mean_thrust_N
         r_demand = demand - alloc.achieved
         r_torque = r_demand[-TORQUE_DIM:]
-        r_force = float(np.linalg.norm(r_demand[:-TORQUE_DIM]))  # empty (0) in attitude-only
+        r_force = float(np.linalg.norm(r_demand[:-TORQUE_DIM]))  # 0 with the torque rows alone
         return CycleResult(
             on_times,
             self.mode,
