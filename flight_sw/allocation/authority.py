@@ -3,10 +3,10 @@
 What it does: from the effectiveness matrix ``B`` (columns ``[d; r × d]``: force [N] and
 torque [N m] per newton of each thruster, flight_sw.allocation.effectiveness), for each
 signed body axis ±x, ±y, ±z of the torque (and of the force, when this flight software
-controls translation too) whether some thrusts ``T ≥ 0`` produce it — and, for
+controls translation too) whether some thrusts ``T ≥ 0`` produce it, and, for
 attitude-only control, whether they produce each torque with zero net force
-(:func:`force_free_torque_unreached`) — : the least
-absolute residual of ``B T = ±e_i`` over ``T ≥ 0`` (a linear programme with slacks
+(:func:`force_free_torque_unreached`). The test: the least absolute residual of
+``B T = ±e_i`` over ``T ≥ 0`` (a linear programme with slacks
 ``B T + s⁺ − s⁻ = ±e_i``, minimising ``Σ s``; HiGHS, flight_sw.allocation.linear_program)
 is zero to round-off exactly when the axis lies in the cone of the columns (Lawson &
 Hanson 1974, ch. 23, for the same test by non-negative least squares, which tests/ use as
