@@ -1,0 +1,188 @@
+"""Step D: plan the de-spin so the spin stops on the target angle with x and y at the target.
+
+What it does: in single spin, with the stopping velocity and position already set (Steps
+B and C), the axis-III torque alone moves the body in x–y (the force turns with the body,
+eq. 9) and is planned in sequences of the exponential de-spin of :mod:`.despin`:
+- **velocity sequences** (seq. 1 of §3.5): a half turn started on the spin angle that
+  points the change where it is needed, sized by η (``|Δv| = 2λη``); used to stop the
+  drift and to set a transfer velocity toward the aim point, then again to stop there;
+  each is planned from the closed forms (start angle, duration, position change) and
+  re-planned from the measured state after it;
+- **coast** (T_III = 0) between sequences;
+- **the final turn** (seq. 3): from ψ_f + 2π with zero velocity, a whole-turn exponential
+  de-spin that stops exactly on ψ_f; its x–y displacement ``Δr_f(ψ_f)`` is a constant of
+  the vehicle (:func:`.despin.final_turn_offset_m`), so the velocity sequences aim at
+  ``−Δr_f``. η is recomputed each cycle from the angle left (``η = −ω_III/(ψ − ψ_f)``),
+  which closes the loop on the stop angle; the last sliver of spin is taken out in one
+  control period.
+The paper's second sequence (a whole-turn partial de-spin that moves the body without
+changing its velocity) is replaced by the transfer-and-stop pair, which reaches any
+distance for a bounded spin cost; if the plan cannot be done before ψ_f + 2π the stop
+moves one turn later (the supervisor is told: that turn count also sets z, Step C).
+
+Inputs per cycle: ψ (unwrapped) [rad], ω_III [rad/s], x–y position [m] and velocity
+[m/s] in R. Output: the axis-III torque to add to Step A's hold [N m] (≥ 0).
+Source: seed 004 §3.5 (eqs. 39–53) and §3.6 (why the plan needs small x–y errors).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from dbc.errors import ConfigError
+from flight_sw.control.underactuated.despin import (
+    TWO_PI,
+    Despin,
+    final_turn_offset_m,
+    half_turn_for,
+    max_half_turn_dv,
+)
+from flight_sw.control.underactuated.geometry import ThreeThrusters
+
+_SOURCE = "[flight_sw.pose] step D"
+
+
+class Phase(enum.Enum):
+    """What Step D is doing."""
+
+    COAST = "coast"
+    VELOCITY = "velocity sequence"
+    FINAL = "final turn"
+    DONE = "done"
+
+
+@dataclass(frozen=True)
+class StepDParams:
+    """Tolerances [m, m/s], transfer lead [s], speed limit [m/s], spin kept per sequence,
+    end of the final turn [rad]."""
+
+    position_tol_m: float = 0.003
+    velocity_tol_m_s: float = 5e-5
+    transfer_lead_s: float = 40.0
+    max_transfer_speed_m_s: float = 0.02
+    keep_spin_fraction: float = 0.5
+    final_angle_tol_rad: float = 1e-3
+
+    def __post_init__(self) -> None:
+        for key in ("position_tol_m", "velocity_tol_m_s", "transfer_lead_s",
+                    "max_transfer_speed_m_s", "final_angle_tol_rad"):
+            value = getattr(self, key)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ConfigError(_SOURCE, key, value, "a finite number > 0")
+        if not 0.0 < self.keep_spin_fraction < 1.0:
+            raise ConfigError(_SOURCE, "keep_spin_fraction", self.keep_spin_fraction,
+                              "a fraction in (0, 1)")
+
+
+def next_angle_below(psi_rad: float, angle_mod_rad: float) -> float:
+    """The largest angle ≤ ψ equal to ``angle_mod_rad`` mod 2π (a negative spin reaches it next)."""
+    return psi_rad - ((psi_rad - angle_mod_rad) % TWO_PI)
+
+
+class StepD:
+    """The de-spin planner (module docstring). ``psi_f_rad`` is the planned stop angle."""
+
+    def __init__(self, thrusters: ThreeThrusters, params: StepDParams, period_s: float) -> None:
+        self.thr = thrusters
+        self.p = params
+        self.period_s = period_s
+        self.lam = thrusters.lateral_m_per_rad_s
+        self.alpha = thrusters.alpha_rad
+        self.j3 = float(thrusters.inertia_diag_kgm2[2])
+        self.phase = Phase.COAST
+        self.psi_f_rad = 0.0
+        self.sequence: Despin | None = None
+        self.sequences = 0
+        self.postponed_turns = 0
+
+    def start(self, psi_f_rad: float) -> None:
+        """Begin planning toward a stop on ``psi_f_rad`` (unwrapped)."""
+        self.psi_f_rad = psi_f_rad
+        self.phase = Phase.COAST
+        self.sequence = None
+
+    def aim_m(self) -> np.ndarray:
+        """Where the final turn must start so that it ends at the origin [m]."""
+        return -final_turn_offset_m(self.psi_f_rad, self.lam, self.alpha)
+
+    def _plan(self, psi: float, w3: float, r: np.ndarray, v: np.ndarray) -> Despin | None:
+        """The next velocity sequence, or None if the drift already fits the plan."""
+        err = self.aim_m() - r
+        dist = float(np.linalg.norm(err))
+        lead = self.p.transfer_lead_s
+        v_des = np.zeros(2)
+        if dist > self.p.position_tol_m:
+            v_des = err / lead
+            speed = float(np.linalg.norm(v_des))
+            if speed > self.p.max_transfer_speed_m_s:
+                v_des *= self.p.max_transfer_speed_m_s / speed
+        if float(np.linalg.norm(v_des - v)) <= self.p.velocity_tol_m_s:
+            return None
+        limit = max_half_turn_dv(w3, self.lam, self.p.keep_spin_fraction)
+        seq = None
+        for _ in range(3):  # aim from where the sequence will start and end
+            dv = v_des - v
+            size = float(np.linalg.norm(dv))
+            if size > limit:
+                dv *= limit / size
+            seq = half_turn_for(dv, w3, self.lam, self.alpha)
+            psi_a = next_angle_below(psi, seq.psi_a_rad)
+            seq = Despin(psi_a, w3, seq.omega_b_rad_s, seq.eta_per_s)
+            wait_s = (psi - psi_a) / abs(w3)
+            r_end = r + v * wait_s + seq.delta_r(v, self.lam, self.alpha)
+            err_end = self.aim_m() - r_end
+            d_end = float(np.linalg.norm(err_end))
+            if d_end <= self.p.position_tol_m:
+                v_des = np.zeros(2)
+            else:
+                v_des = err_end / lead
+                speed = float(np.linalg.norm(v_des))
+                if speed > self.p.max_transfer_speed_m_s:
+                    v_des *= self.p.max_transfer_speed_m_s / speed
+        return seq
+
+    def torque_III_Nm(self, psi: float, w3: float, r_xy: np.ndarray, v_xy: np.ndarray) -> float:
+        """The axis-III torque to add this cycle [N m] (≥ 0)."""
+        if self.phase is Phase.DONE:
+            return 0.0
+        if self.phase is Phase.FINAL:
+            left = psi - self.psi_f_rad
+            if left <= self.p.final_angle_tol_rad or w3 >= 0.0:
+                self.phase = Phase.DONE
+                return max(0.0, -self.j3 * w3 / self.period_s)  # the last sliver
+            return -self.j3 * w3 * (-w3 / left)  # T = −η J ω, η = −ω/(ψ − ψ_f)
+        start_final = self.psi_f_rad + TWO_PI
+        if self.phase is Phase.VELOCITY and self.sequence is not None:
+            if psi > self.sequence.psi_b_rad:
+                return -self.sequence.eta_per_s * self.j3 * w3
+            self.phase, self.sequence = Phase.COAST, None
+        # the final turn starts on the cycle nearest ψ_f + 2π (a turn short by δ leaves
+        # a velocity of about λ η δ, which the slow tail turns into drift)
+        if psi <= start_final + 0.5 * abs(w3) * self.period_s:
+            settled = (float(np.linalg.norm(v_xy)) <= self.p.velocity_tol_m_s
+                       and float(np.linalg.norm(self.aim_m() - r_xy)) <= self.p.position_tol_m)
+            if settled:
+                self.phase = Phase.FINAL
+                return self.torque_III_Nm(psi, w3, r_xy, v_xy)
+            self.psi_f_rad -= TWO_PI  # not ready: stop one turn later
+            self.postponed_turns += 1
+            self.sequence = None
+        if self.sequence is None:
+            self.sequence = self._plan(psi, w3, np.asarray(r_xy), np.asarray(v_xy))
+            while self.sequence is not None and self.sequence.psi_b_rad < start_final:
+                self.psi_f_rad -= TWO_PI  # it ends after the final turn's start: a turn later
+                self.postponed_turns += 1
+                start_final -= TWO_PI
+        if self.sequence is not None and psi <= self.sequence.psi_a_rad:
+            self.phase = Phase.VELOCITY
+            self.sequences += 1
+            seq = self.sequence
+            # start now, from the measured spin (the plan used the spin at planning time)
+            self.sequence = Despin(psi, w3, w3 + (seq.omega_b_rad_s - seq.omega_a_rad_s),
+                                   seq.eta_per_s)
+            return -seq.eta_per_s * self.j3 * w3
+        return 0.0
