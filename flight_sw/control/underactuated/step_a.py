@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
 from flight_sw.control.underactuated.geometry import ThreeThrusters
 from flight_sw.control.underactuated.invariants import target_z_in_B
@@ -54,9 +55,7 @@ class StepAParams:
     def __post_init__(self) -> None:
         for key in ("pointing_gain_per_s", "rate_gain_per_s", "max_rate_rad_s",
                     "spin_up_rate_rad_s", "spin_min_rad_s", "spin_target_rad_s"):
-            value = getattr(self, key)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ConfigError(_SOURCE, key, value, "a finite number > 0")
+            check.positive(_SOURCE, key, getattr(self, key))
         if self.spin_target_rad_s <= self.spin_min_rad_s:
             raise ConfigError(_SOURCE, "spin_target_rad_s", self.spin_target_rad_s,
                               f"> spin_min_rad_s = {self.spin_min_rad_s}")

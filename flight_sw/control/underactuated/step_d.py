@@ -28,11 +28,11 @@ Source: seed 004 §3.5 (eqs. 39–53) and §3.6 (why the plan needs small x–y 
 from __future__ import annotations
 
 import enum
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from dbc import validation as check
 from dbc.errors import ConfigError
 from flight_sw.control.underactuated.despin import (
     TWO_PI,
@@ -70,9 +70,7 @@ class StepDParams:
     def __post_init__(self) -> None:
         for key in ("position_tol_m", "velocity_tol_m_s", "transfer_lead_s",
                     "max_transfer_speed_m_s", "final_angle_tol_rad"):
-            value = getattr(self, key)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ConfigError(_SOURCE, key, value, "a finite number > 0")
+            check.positive(_SOURCE, key, getattr(self, key))
         if not 0.0 < self.keep_spin_fraction < 1.0:
             raise ConfigError(_SOURCE, "keep_spin_fraction", self.keep_spin_fraction,
                               "a fraction in (0, 1)")
