@@ -29,7 +29,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import sici
 
-EULER_GAMMA = 0.5772156649015329
 TWO_PI = 2.0 * math.pi
 HALF_TURN_RAD = math.pi
 
@@ -44,7 +43,7 @@ def cin(x: float) -> float:
         return 0.0
     if x < 1e-4:
         return x * x / 4.0
-    return EULER_GAMMA + math.log(x) - float(sici(x)[1])
+    return float(np.euler_gamma) + math.log(x) - float(sici(x)[1])
 
 
 @dataclass(frozen=True)

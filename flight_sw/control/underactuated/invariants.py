@@ -30,11 +30,6 @@ from flight_sw.quaternion import to_dcm
 TWO_PI = 2.0 * math.pi
 
 
-def axis_III_in_R(q_BR: np.ndarray) -> np.ndarray:
-    """Unit vector of body axis III expressed in R (the third row of C_BR)."""
-    return to_dcm(q_BR)[2].copy()
-
-
 def target_z_in_B(q_BR: np.ndarray) -> np.ndarray:
     """The target z axis of R expressed in body axes (the third column of C_BR)."""
     return to_dcm(q_BR)[:, 2].copy()

@@ -78,10 +78,6 @@ class StepA:
         self._spin_dir = np.array([1.0, -math.copysign(1.0, j[0] - j[1])]) / math.sqrt(2.0)
         self.spinning_up = True
 
-    def reset(self) -> None:
-        """Forget the spin-up latch (a restart)."""
-        self.spinning_up = True
-
     def rate_demand(self, q_BR: np.ndarray, omega_BN_B: np.ndarray) -> np.ndarray:
         """The transverse rate demand (ω_I, ω_II) [rad/s]; updates the spin-up latch."""
         w3 = float(omega_BN_B[2])

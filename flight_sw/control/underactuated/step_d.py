@@ -107,17 +107,21 @@ class StepD:
         """Where the final turn must start so that it ends at the origin [m]."""
         return -final_turn_offset_m(self.psi_f_rad, self.lam, self.alpha)
 
+    def _transfer_velocity(self, r_from: np.ndarray) -> np.ndarray:
+        """The x–y velocity that closes the gap to the aim point in the transfer lead time
+        (at most the transfer speed; zero once inside the position tolerance) [m/s]."""
+        err = self.aim_m() - r_from
+        if float(np.linalg.norm(err)) <= self.p.position_tol_m:
+            return np.zeros(2)
+        v_des = err / self.p.transfer_lead_s
+        speed = float(np.linalg.norm(v_des))
+        if speed > self.p.max_transfer_speed_m_s:
+            v_des *= self.p.max_transfer_speed_m_s / speed
+        return v_des
+
     def _plan(self, psi: float, w3: float, r: np.ndarray, v: np.ndarray) -> Despin | None:
         """The next velocity sequence, or None if the drift already fits the plan."""
-        err = self.aim_m() - r
-        dist = float(np.linalg.norm(err))
-        lead = self.p.transfer_lead_s
-        v_des = np.zeros(2)
-        if dist > self.p.position_tol_m:
-            v_des = err / lead
-            speed = float(np.linalg.norm(v_des))
-            if speed > self.p.max_transfer_speed_m_s:
-                v_des *= self.p.max_transfer_speed_m_s / speed
+        v_des = self._transfer_velocity(r)
         if float(np.linalg.norm(v_des - v)) <= self.p.velocity_tol_m_s:
             return None
         limit = max_half_turn_dv(w3, self.lam, self.p.keep_spin_fraction)
@@ -131,16 +135,8 @@ class StepD:
             psi_a = next_angle_below(psi, seq.psi_a_rad)
             seq = Despin(psi_a, w3, seq.omega_b_rad_s, seq.eta_per_s)
             wait_s = (psi - psi_a) / abs(w3)
-            r_end = r + v * wait_s + seq.delta_r(v, self.lam, self.alpha)
-            err_end = self.aim_m() - r_end
-            d_end = float(np.linalg.norm(err_end))
-            if d_end <= self.p.position_tol_m:
-                v_des = np.zeros(2)
-            else:
-                v_des = err_end / lead
-                speed = float(np.linalg.norm(v_des))
-                if speed > self.p.max_transfer_speed_m_s:
-                    v_des *= self.p.max_transfer_speed_m_s / speed
+            v_des = self._transfer_velocity(
+                r + v * wait_s + seq.delta_r(v, self.lam, self.alpha))
         return seq
 
     def torque_III_Nm(self, psi: float, w3: float, r_xy: np.ndarray, v_xy: np.ndarray) -> float:
