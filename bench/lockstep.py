@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from bench.results.record import FLUSH_PERIOD_NS
 from bench.station.fault_book import Event
 from bench.station.plant import STEP_NS
 from bench.station.station import Pulse
@@ -29,7 +30,7 @@ if TYPE_CHECKING:
     from bench.node import BenchNode
 
 NS_PER_S = 1_000_000_000
-FLUSH_EVERY_CYCLES = 5  # run files go to disk this often (and the progress line is updated)
+PROGRESS_EVERY_CYCLES = 5  # the progress line is updated this often
 SILENT_AFTER_STALLS = 3
 
 
@@ -38,6 +39,8 @@ class Lockstep:
 
     def __init__(self, node: BenchNode) -> None:
         self.node = node
+        #: cycles between two flushes of the run files (FLUSH_PERIOD_NS, at least one)
+        self.flush_every = max(1, FLUSH_PERIOD_NS // node.period_ns)
         self.consecutive_stalls = 0
         # wall-clock marks of the current cycle [ns, the node's clock]: SYNC handed over,
         # the wait for the answer ended (the per-cycle split in summary.json)
@@ -93,11 +96,11 @@ class Lockstep:
         wire.release()  # delayed frames released meanwhile
         n.trace.write_pending()
         results.write_pending()
-        if k % FLUSH_EVERY_CYCLES == 0:
+        if k % self.flush_every == 0:
             n.trace.flush()
             results.flush()
-            if n.progress is not None:
-                n.progress(k * n.period_ns / NS_PER_S, duration_s)
+        if k % PROGRESS_EVERY_CYCLES == 0 and n.progress is not None:
+            n.progress(k * n.period_ns / NS_PER_S, duration_s)
         n.check_fsw_alive()  # here, not after the cycle: its poll is off the critical path
         got: list[tuple[int, int, dict[str, float], int]] = []  # (frame, seq, signals, delay)
         lost = 0  # command frames that injected faults kept from the bench this cycle

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import can
 from mypy_extensions import mypyc_attr
 
+from bench.results.record import FLUSH_PERIOD_NS
 from bench.station.fault_book import Event
 from bench.station.plant import STEP_NS
 from bench.station.station import Pulse
@@ -29,7 +30,7 @@ if TYPE_CHECKING:
 NS_PER_S = 1_000_000_000
 NS_PER_MS = 1e6
 RT_FRAMES_PER_PASS = 64  # realtime: frames read between two steps toward the wall clock
-FLUSH_EVERY_CYCLES = 5  # run files go to disk this often (and the progress line is updated)
+PROGRESS_EVERY_CYCLES = 5  # liveness check and progress line this often
 
 
 @mypyc_attr(allow_interpreted_subclasses=True)  # tests count the frames it handles
@@ -59,7 +60,7 @@ class Realtime:
         n._realtime_clock = clock
         n._start()
         n._emit_samples(0)
-        next_progress = 0
+        next_progress = next_flush = 0
         while st.t_ns < end_ns:
             results.note_lag(clock.now_ns() - st.t_ns, n.period_ns)
             n.integrate_to(min(clock.now_ns(), end_ns) // STEP_NS * STEP_NS)
@@ -72,13 +73,15 @@ class Realtime:
                 if n_read >= RT_FRAMES_PER_PASS or st.t_ns >= end_ns:
                     break  # back to stepping; the rest stays queued for the next pass
                 msg = n.bus.recv(timeout=0.0)
-            if st.t_ns >= next_progress:
-                n.check_fsw_alive()
+            if st.t_ns >= next_flush:
                 n.trace.flush()
                 results.flush()
+                next_flush += FLUSH_PERIOD_NS
+            if st.t_ns >= next_progress:
+                n.check_fsw_alive()
                 if n.progress is not None:
                     n.progress(st.t_ns / NS_PER_S, duration_s)
-                next_progress += FLUSH_EVERY_CYCLES * n.period_ns
+                next_progress += PROGRESS_EVERY_CYCLES * n.period_ns
         n._realtime_clock = None
         results.wall_s = clock.now_ns() / NS_PER_S
         n.trace.event(st.t_ns, "run_finished", late_steps=results.late_steps,

@@ -51,7 +51,7 @@ CAMPAIGN_COPY = "campaign.toml"
 MANIFEST = "manifest.json"
 TELEMETRY_DECIMATION = 10
 """A pruned case keeps every this-many-th telemetry row (100 Hz -> 10 Hz)."""
-PRUNED = ("trace.asc", "frames.csv", "chains.csv", "valve_pulses.csv")
+PRUNED = ("trace.asc", "trace.blf", "frames.csv", "chains.csv", "valve_pulses.csv")
 """Per-case files removed from cases that neither failed nor are among the worst."""
 
 

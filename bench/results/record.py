@@ -8,13 +8,15 @@ Two levels (``thruster-hil run --record``, ``bench --record``):
   fifth of the size (figures below). python-can reads ``.asc.gz``
   as it is (``can.LogReader``, ``python -m can.player``); for a tool that wants plain ASC
   (CANoe, SavvyCAN), ``gunzip trace.asc.gz``.
-* ``full``: the same files uncompressed, and the trace in Vector's binary logging format
-  too (``trace.blf``, bench.wire.trace; ~5 kB per simulated second more, which the
-  standard level leaves out to stay within a quarter of the 80 kB/s an uncompressed run
-  took before: ``python -m can.logconvert trace.asc.gz trace.blf`` makes it from any run).
+* ``full``: the same files uncompressed.
 
-Sizes (``python benchmarks/run_resources.py --durations 600``, quickstart): about 16 kB per
-simulated second at ``standard``, 84 kB at ``full`` (README, "What a run gives you").
+Both levels also write the trace in Vector's binary logging format, ``trace.blf``
+(bench.wire.trace; itself zlib-compressed, ~5 kB per simulated second), so CANoe and
+CANalyzer open any run's trace as it is.
+
+Sizes (``python benchmarks/run_resources.py --durations 600``, quickstart): about 19 kB per
+simulated second at ``standard`` (``trace.blf``'s 5 kB included), 79 kB at ``full`` (README,
+"What a run gives you").
 
 Compressed files are flushed as the run goes like the plain ones (a gzip *sync flush*:
 everything written so far can be decompressed), so a crashed or killed run's files are
@@ -47,6 +49,11 @@ GZ_SUFFIX = ".gz"
 # ~3.7x; the compression runs while the flight software computes its cycle (deferred
 # writing), so the better ratio costs no real-time factor.
 GZIP_LEVEL = 6
+# The run loops flush the run-folder files this often (simulated time): a killed bench loses
+# at most this much of them. Each gzip sync flush ends a deflate block; flushing every
+# 0.1 s made the compressed files ~0.8 kB per simulated second bigger than every 0.5 s
+# (quickstart).
+FLUSH_PERIOD_NS = 500_000_000
 
 
 def check_record(record: str, where: str = "--record") -> str:

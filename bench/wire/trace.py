@@ -6,14 +6,16 @@ trace and to ``frames.csv`` (bench.results.record).
 * ``trace.asc`` — every frame the bench sent or received, in wire order, with its
   modelled (lockstep) or measured (realtime) time of reception; Tx = sent by the bench.
   Written through python-can's ``ASCWriter`` so python-can, Vector tools and SavvyCAN
-  read it; flushed once per control cycle, so a crash loses at most one cycle.
-* ``trace.blf`` (``--record full``) — the same frames and events in Vector's binary logging
-  format (python-can's ``BLFWriter``: zlib-compressed containers; CANoe and CANalyzer open
-  it natively), with the same run-time timestamps (the measurement start is 0: no date;
-  ``trace.asc`` has it) at 1 ns resolution. Written in containers as they fill and
-  completed when the run ends, however it ends but SIGKILL; ``trace.asc`` is the trace that
-  survives a kill. About 5.3 kB per simulated second for the quickstart (its ASC, gzip:
-  5.1 kB; plain: 28 kB); ~1.5 µs of the bench's time per frame.
+  read it; flushed every ``FLUSH_PERIOD_NS`` of run time (bench.results.record), so a killed
+  bench loses at most that much.
+* ``trace.blf`` (every run, at either record level) — the same frames and events in
+  Vector's binary logging format (python-can's ``BLFWriter``: zlib-compressed containers;
+  CANoe and CANalyzer open it natively), with the same run-time timestamps (the
+  measurement start is 0: no date; ``trace.asc`` has it) at 1 ns resolution. Written in
+  containers as they fill and completed when the run ends, however it ends but SIGKILL;
+  ``trace.asc`` is the trace that survives a kill. About 5.3 kB per simulated second for
+  the quickstart (its ASC, gzip: 5.1 kB; plain: 28 kB); ~2 µs of the bench's time per
+  frame, spent while the flight software computes (deferred writing).
 * ``frames.csv`` — one row per frame of the trace, same order: when it was queued for
   transmission (``t_ready_s``), when it won arbitration (``t_start_s``), when it was received
   (``t_rx_s``), ID, DLC, bits on the wire, ``tx`` (1 = sent by the bench) and alive counter.
@@ -69,10 +71,8 @@ class TraceRecorder:
         # (kind, t_ns, message or None, tx, event text): in trace order until written
         self._pending: list[tuple[int, int, can.Message | None, bool, str]] = []
         self._writer = w = can.ASCWriter(open_writer(self.path), channel=1)
-        self._blf: can.BLFWriter | None = None
-        if record == RECORD_FULL:
-            self._blf = can.BLFWriter(run_dir / BLF_NAME, channel=1)
-            self._blf.start_timestamp = 0.0  # run time, as in the ASC trace (docstring)
+        self._blf = can.BLFWriter(run_dir / BLF_NAME, channel=1)
+        self._blf.start_timestamp = 0.0  # run time, as in the ASC trace (docstring)
         # The trigger block is dated when the run started (metadata, as the file's "date"
         # line); frame times stay run time, relative to it. Left to python-can, it is dated
         # from the first frame's timestamp: 1 Jan 1970 for a run that starts at t = 0.
@@ -125,8 +125,7 @@ class TraceRecorder:
             channel=0,
         )
         self._writer.on_message_received(record)
-        if self._blf is not None:
-            self._blf.on_message_received(record)
+        self._blf.on_message_received(record)
 
     def error_frame(self, t_ns: int) -> None:
         """An error frame on the bus at ``t_ns`` (ASC ``ErrorFrame`` line)."""
@@ -139,13 +138,11 @@ class TraceRecorder:
     def _write_error(self, t_ns: int) -> None:
         record = can.Message(timestamp=t_ns / NS_PER_S, is_error_frame=True, channel=0)
         self._writer.on_message_received(record)
-        if self._blf is not None:
-            self._blf.on_message_received(record)
+        self._blf.on_message_received(record)
 
     def _write_event(self, t_ns: int, line: str) -> None:
         self._writer.log_event(line, t_ns / NS_PER_S)
-        if self._blf is not None:
-            self._blf.log_event(line, t_ns / NS_PER_S)
+        self._blf.log_event(line, t_ns / NS_PER_S)
 
     def event(self, t_ns: int, what: str, /, **fields: Any) -> None:
         """Append one event line (``what`` at ``t_ns`` with ``fields``) and flush it; the
@@ -184,8 +181,7 @@ class TraceRecorder:
         """Finish every file."""
         self.write_pending()
         self._writer.stop()
-        if self._blf is not None:
-            self._blf.stop()
+        self._blf.stop()
         self._frames.close()
         self._events.close()
 

@@ -70,7 +70,7 @@ def test_rerun_never_deletes_a_folder_it_did_not_make(
 
 
 def test_prune_drops_a_passing_case_trace_and_keeps_every_tenth_row(tmp_path: Path) -> None:
-    """A passing case that is not among the worst: its trace gone, its telemetry the header
+    """A passing case that is not among the worst: its traces gone, its telemetry the header
     and rows 0, 10, 20; a failing case untouched."""
     import gzip
 
@@ -85,10 +85,12 @@ def test_prune_drops_a_passing_case_trace_and_keeps_every_tenth_row(tmp_path: Pa
             f.write("t_s\n" + "".join(f"{i}\n" for i in range(25)))
         with gzip.open(run / "trace.asc.gz", "wt", encoding="utf-8") as f:
             f.write("date x\n")
+        (run / "trace.blf").write_bytes(b"LOGG")
         rows.append({"name": name, "status": "ok", "passed": passed})
     assert prune(tmp_path, rows, {"worst": {}}, "failing") == 1
     kept = tmp_path / "cases" / "0000" / "run"
     with gzip.open(kept / "telemetry.csv.gz", "rt", encoding="utf-8") as f:
         assert f.read().split() == ["t_s", *(str(i) for i in range(0, 25, TELEMETRY_DECIMATION))]
-    assert not (kept / "trace.asc.gz").exists()
+    assert not (kept / "trace.asc.gz").exists() and not (kept / "trace.blf").exists()
     assert (tmp_path / "cases" / "0001" / "run" / "trace.asc.gz").exists()
+    assert (tmp_path / "cases" / "0001" / "run" / "trace.blf").exists()

@@ -102,10 +102,14 @@ def test_blf_holds_the_frames_of_the_asc_trace(tmp_path: Path) -> None:
                                                           ).read_bytes()
 
 
-def test_standard_record_writes_no_blf(tmp_path: Path) -> None:
-    """The default level keeps the folder small: the compressed ASC trace, no BLF."""
+def test_standard_record_writes_blf_beside_the_compressed_asc(tmp_path: Path) -> None:
+    """The default level writes trace.asc.gz and trace.blf, and they hold the same frames."""
     rec = TraceRecorder(tmp_path, START_WALL_S, record=RECORD_STANDARD)
     rec.frame(can.Message(arbitration_id=FRAME_ID, data=b"\x01", is_extended_id=False),
               T_FRAME_NS, tx=True)
     rec.close()
-    assert (tmp_path / "trace.asc.gz").exists() and not (tmp_path / BLF_NAME).exists()
+    asc = list(can.LogReader(tmp_path / "trace.asc.gz"))
+    blf = list(can.LogReader(tmp_path / BLF_NAME))
+    assert not (tmp_path / "trace.asc").exists()
+    assert [(m.arbitration_id, bytes(m.data)) for m in asc] == [(FRAME_ID, b"\x01")]
+    assert [(m.arbitration_id, bytes(m.data)) for m in blf] == [(FRAME_ID, b"\x01")]
