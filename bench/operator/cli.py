@@ -267,7 +267,8 @@ def build_parser() -> argparse.ArgumentParser:
                        default=RECORD_STANDARD, metavar="{standard,full}",
                        help="standard: the CAN trace and the CSV tables gzip-compressed "
                        "(trace.asc.gz, telemetry.csv.gz, ...: about a fifth of the size); "
-                       "full: the same files as plain text (default standard)")
+                       "full: the same files as plain text (default standard); both also "
+                       "write the trace as trace.blf")
         r.add_argument("--no-plots", action="store_true",
                        help="leave out the PNG plots (~0.3 s sooner: no matplotlib, no "
                        "drawing); `thruster-hil report RUN_DIR` draws them later")

@@ -2,7 +2,10 @@
 
 In: every frame on any python-can bus (a run's channel, SocketCAN, an adapter on real
 hardware), read by a thread of its own into bench.operator.monitor_state, which checks and
-decodes it with the DBC. Out: a terminal console redrawn every ``--refresh`` seconds: the
+decodes it with the DBC; the bus itself is read by a relay process (transport.relay), so
+that the terminal's redraws never hold up the reading (a thread beside them would get the
+interpreter too seldom to keep up with a realtime run). Times are seconds since the
+monitor started. Out: a terminal console redrawn every ``--refresh`` seconds: the
 vehicle (flight-software mode, FDIR flags, failed thruster, estimated attitude, rates,
 position, the bench's time, health and faults), the bus load, a message table (ID, name,
 count, period, jitter, rejects by cause, last decoded signals), the thrusters (commanded and
@@ -28,6 +31,7 @@ from cantools.database.can import Database
 
 from bench.operator.monitor_state import MonitorState
 from dbc.errors import ConfigError
+from transport.relay import RelayBus
 
 RECV_POLL_S = 0.1  # the reader's longest wait, so that it sees a stop request
 DEFAULT_REFRESH_S = 0.25
@@ -40,6 +44,7 @@ class BusReader:
 
     def __init__(self, bus: can.BusABC, state: MonitorState) -> None:
         self.bus, self.state = bus, state
+        self.t0_ns = time.monotonic_ns()  # the monitor's times count from here
         self.lock = threading.Lock()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="monitor-reader", daemon=True)
@@ -55,8 +60,10 @@ class BusReader:
         while not self._stop.is_set():
             msg = self.bus.recv(RECV_POLL_S)
             if msg is not None:
+                # the edge's clock: when the relay read it, else now
+                t_ns = getattr(self.bus, "last_rx_monotonic_ns", 0) or time.monotonic_ns()
                 with self.lock:
-                    self.state.feed(msg, time.monotonic_ns())  # the edge's clock
+                    self.state.feed(msg, t_ns - self.t0_ns)
 
     def snapshot(self) -> dict[str, Any]:
         with self.lock:
@@ -80,8 +87,8 @@ def vehicle_text(s: dict[str, Any]) -> str:
                            else "-")
         + f"   bench t {_fmt(v.get('sim_time_s'), '.2f')} s  health {v.get('health', '-')}"
         f"  faults {v.get('active_faults', '-')}",
-        f"bus load {100.0 * s['bus_load']:.1f} % of the last wall-clock second (lockstep: "
-        f"faster than real time)   frames {s['frames']}",
+        f"bus load {100.0 * s['bus_load']:.1f} % of the last wall-clock second (a lockstep "
+        f"run goes faster than real time: more than its modelled load)   frames {s['frames']}",
     ]
     return "\n".join(lines)
 
@@ -185,9 +192,8 @@ def watch_run(bus_spec: str, pid: int, before_app: Callable[[], None] | None = N
     import sys
 
     from dbc.database import load_database
-    from transport.spec import open_bus
 
-    bus = open_bus(bus_spec)
+    bus = RelayBus(spec=bus_spec)
     reader = BusReader(bus, MonitorState(db or load_database()))
     reader.start()
     try:
@@ -223,14 +229,14 @@ def run(args: Any, db: Database | None = None) -> int:
     import sys
 
     from dbc.database import load_database
-    from transport.spec import check_bus_spec, open_bus
+    from transport.spec import check_bus_spec
 
     check_bus_spec(args.bus)
     if not sys.stdout.isatty() and args.duration is None:
         raise ConfigError("command line", "--duration", None, "a duration when the output "
                           "is not a terminal (the monitor then prints its last picture)")
     db = db or load_database()
-    bus = open_bus(args.bus)
+    bus = RelayBus(spec=args.bus)
     reader = BusReader(bus, MonitorState(db))
     reader.start()
     print(f"thruster-hil monitor: listening on {args.bus}", file=sys.stderr, flush=True)
