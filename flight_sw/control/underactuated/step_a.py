@@ -43,14 +43,17 @@ _SOURCE = "[flight_sw.pose] step A"
 
 @dataclass(frozen=True)
 class StepAParams:
-    """Gains [1/s], rates [rad/s] (spin rates are magnitudes of the negative spin)."""
+    """Gains [1/s], rates [rad/s] (spin rates are magnitudes of the negative spin).
 
-    pointing_gain_per_s: float = 0.5
+    The defaults are gentle: every N s of thrust here leaves x–y velocity that Step D
+    pays for in spin (docs/reproductions.md, seed 004)."""
+
+    pointing_gain_per_s: float = 0.3
     rate_gain_per_s: float = 4.0
-    max_rate_rad_s: float = 0.1
-    spin_up_rate_rad_s: float = 0.4
-    spin_min_rad_s: float = 0.1
-    spin_target_rad_s: float = 0.35
+    max_rate_rad_s: float = 0.05
+    spin_up_rate_rad_s: float = 0.2
+    spin_min_rad_s: float = 0.09
+    spin_target_rad_s: float = 0.15
 
     def __post_init__(self) -> None:
         for key in ("pointing_gain_per_s", "rate_gain_per_s", "max_rate_rad_s",
@@ -64,6 +67,14 @@ class StepAParams:
 def tilt_rad(q_BR: np.ndarray) -> float:
     """Angle between body axis III and the target z [rad]."""
     return math.acos(max(-1.0, min(1.0, float(target_z_in_B(q_BR)[2]))))
+
+
+def in_single_spin(q_BR: np.ndarray, omega_BN_B: np.ndarray, tilt_max_rad: float,
+                   rate_max_rad_s: float) -> bool:
+    """Step A's exit condition: axis III within ``tilt_max_rad`` of the target z and the
+    transverse rates below ``rate_max_rad_s`` (the manifold of seed 004 §3.2)."""
+    return (tilt_rad(q_BR) <= tilt_max_rad
+            and math.hypot(float(omega_BN_B[0]), float(omega_BN_B[1])) <= rate_max_rad_s)
 
 
 class StepA:

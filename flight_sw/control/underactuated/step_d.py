@@ -103,6 +103,13 @@ class StepD:
         self.phase = Phase.COAST
         self.sequence = None
 
+    def settled(self, r_xy: np.ndarray, v_xy: np.ndarray) -> bool:
+        """At the aim point and at rest in x–y, within the tolerances: ready for the final
+        turn."""
+        return (float(np.linalg.norm(v_xy)) <= self.p.velocity_tol_m_s
+                and float(np.linalg.norm(self.aim_m() - np.asarray(r_xy)))
+                <= self.p.position_tol_m)
+
     def aim_m(self) -> np.ndarray:
         """Where the final turn must start so that it ends at the origin [m]."""
         return -final_turn_offset_m(self.psi_f_rad, self.lam, self.alpha)
@@ -148,20 +155,25 @@ class StepD:
             if left <= self.p.final_angle_tol_rad or w3 >= 0.0:
                 self.phase = Phase.DONE
                 return max(0.0, -self.j3 * w3 / self.period_s)  # the last sliver
-            return -self.j3 * w3 * (-w3 / left)  # T = −η J ω, η = −ω/(ψ − ψ_f)
+            # T = −η J ω with η = −ω/(ψ − ψ_f), taken at mid-period: the torque is held
+            # over the period, and the exponential de-spin's mid-period torque is
+            # η J |ω| e^(−η h/2) ≈ J ω² / (ψ − ψ_f + |ω| h/2). Taken at the period's start
+            # (forward Euler) the turn ended ~λ |ω| h / 2 off (3.7 mm at 0.3 rad/s, h 20 ms).
+            return self.j3 * w3 * w3 / (left - 0.5 * w3 * self.period_s)
         start_final = self.psi_f_rad + TWO_PI
         if self.phase is Phase.VELOCITY and self.sequence is not None:
             if psi > self.sequence.psi_b_rad:
                 return -self.sequence.eta_per_s * self.j3 * w3
             self.phase, self.sequence = Phase.COAST, None
-        # the final turn starts on the cycle nearest ψ_f + 2π (a turn short by δ leaves
-        # a velocity of about λ η δ, which the slow tail turns into drift)
-        if psi <= start_final + 0.5 * abs(w3) * self.period_s:
-            settled = (float(np.linalg.norm(v_xy)) <= self.p.velocity_tol_m_s
-                       and float(np.linalg.norm(self.aim_m() - r_xy)) <= self.p.position_tol_m)
-            if settled:
+        # the final turn starts where ψ passes ψ_f + 2π, inside this period: its first
+        # torque is scaled by the part of the period after the crossing (the same
+        # impulse; a turn started δ late ends about λ δ off, 8 mm per mrad at λ = 2 m)
+        step = abs(w3) * self.period_s
+        if psi - step < start_final:
+            if self.settled(r_xy, v_xy):
                 self.phase = Phase.FINAL
-                return self.torque_III_Nm(psi, w3, r_xy, v_xy)
+                after = min(1.0, (start_final - (psi - step)) / step) if step > 0.0 else 1.0
+                return after * self.j3 * w3 * w3 / TWO_PI
             self.psi_f_rad -= TWO_PI  # not ready: stop one turn later
             self.postponed_turns += 1
             self.sequence = None
