@@ -56,7 +56,7 @@ class DisturbanceParams:
 
     block_periods: int = 5
     horizon_turns: float = 1.0
-    max_dv_stop_m_s: float = 0.02
+    max_dv_stop_m_s: float = 0.04
     max_thrust_N: float | None = None
 
     def __post_init__(self) -> None:

@@ -51,9 +51,9 @@ class StepAParams:
     pointing_gain_per_s: float = 0.3
     rate_gain_per_s: float = 4.0
     max_rate_rad_s: float = 0.05
-    spin_up_rate_rad_s: float = 0.2
-    spin_min_rad_s: float = 0.09
-    spin_target_rad_s: float = 0.15
+    spin_up_rate_rad_s: float = 0.3
+    spin_min_rad_s: float = 0.15
+    spin_target_rad_s: float = 0.25
 
     def __post_init__(self) -> None:
         for key in ("pointing_gain_per_s", "rate_gain_per_s", "max_rate_rad_s",

@@ -28,6 +28,7 @@ Source: seed 004 §3.5 (eqs. 39–53) and §3.6 (why the plan needs small x–y 
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -93,13 +94,16 @@ class StepD:
         self.j3 = float(thrusters.inertia_diag_kgm2[2])
         self.phase = Phase.COAST
         self.psi_f_rad = 0.0
+        self.transfer = True
         self.sequence: Despin | None = None
         self.sequences = 0
         self.postponed_turns = 0
 
-    def start(self, psi_f_rad: float) -> None:
-        """Begin planning toward a stop on ``psi_f_rad`` (unwrapped)."""
+    def start(self, psi_f_rad: float, transfer: bool = True) -> None:
+        """Begin planning toward a stop on ``psi_f_rad`` (unwrapped); ``transfer=False``
+        only stops the x–y drift where the body is (no move toward the aim point)."""
         self.psi_f_rad = psi_f_rad
+        self.transfer = transfer
         self.phase = Phase.COAST
         self.sequence = None
 
@@ -112,13 +116,16 @@ class StepD:
 
     def aim_m(self) -> np.ndarray:
         """Where the final turn must start so that it ends at the origin [m]."""
-        return -final_turn_offset_m(self.psi_f_rad, self.lam, self.alpha)
+        # the offset turns with ψ_f mod 2π; the remainder keeps the closed form's angles
+        # small when ψ_f is far ahead (the supervisor's transfer)
+        return -final_turn_offset_m(math.remainder(self.psi_f_rad, TWO_PI), self.lam,
+                                    self.alpha)
 
     def _transfer_velocity(self, r_from: np.ndarray) -> np.ndarray:
         """The x–y velocity that closes the gap to the aim point in the transfer lead time
         (at most the transfer speed; zero once inside the position tolerance) [m/s]."""
         err = self.aim_m() - r_from
-        if float(np.linalg.norm(err)) <= self.p.position_tol_m:
+        if not self.transfer or float(np.linalg.norm(err)) <= self.p.position_tol_m:
             return np.zeros(2)
         v_des = err / self.p.transfer_lead_s
         speed = float(np.linalg.norm(v_des))
