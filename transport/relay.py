@@ -166,6 +166,7 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the reader decides when this ends
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
     out = sys.stdout.fileno()
+    reader_pid = os.getppid()
     try:
         bus = open_bus(args[0])
     except Exception as exc:  # any failure is reported to the reader, which raises it
@@ -176,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
         while True:
             msg = bus.recv(RECV_POLL_S)
             if msg is None:
-                if os.getppid() == 1:  # the reader's process has gone
+                if os.getppid() != reader_pid:  # the reader's process has gone (reparented)
                     return 0
                 continue
             batch = [pack(msg, time.monotonic_ns())]
