@@ -175,9 +175,7 @@ class Supervisor:
                                              float(v_R_m_s[2]))
             if self.step_c.phase is not PhaseC.DONE:
                 return torque
-            fine = self.fine
             self.step_d.start(self.step_c.psi_f_rad)
-            self.fine = fine
             self._switch(t_s, Mode.D)
         if self.mode is Mode.D:
             psi_f = self.step_d.psi_f_rad
