@@ -1,7 +1,9 @@
 """Run one campaign case as ``thruster-hil run`` and turn its run folder into a result row.
 
 A case runs as its own ``thruster-hil run SCENARIO --seed S --set ... --no-plots`` process
-(bench + flight software on a portable-bus channel of its own: no ``--bus``), in a fresh
+(bench + flight software on a portable-bus channel of its own: no ``--bus``): on a Dask
+worker of the campaign, forked by the worker's zygote (bench.campaign.zygote: the same
+run without the imports, ~0.6 CPU-s less a case); elsewhere a new interpreter. In a fresh
 attempt folder ``cases/NAME.attempt-<hex>/`` that is renamed to ``cases/NAME/`` only
 once the run has ended and its result is written, so a killed or repeated attempt never
 leaves a half case under the final name and a case is never counted twice. The run is
@@ -13,8 +15,9 @@ a row with status ``"refused"``: not retried (the same input is refused again).
 
 Out: ``cases/NAME/case.json`` (the case: overrides, seed, the command that reproduces it)
 and ``cases/NAME/result.json`` (the row: :func:`result_row`), beside the run folder's
-files in ``cases/NAME/run/``. ``trace_sha256`` is the digest of the CAN trace's records
-(the ASC header's wall-clock date lines left out), the figure a rerun is compared on.
+files in ``cases/NAME/run/`` and the run's console output, ``cases/NAME/stderr.log``.
+``trace_sha256`` is the SHA-256 of the CAN trace as ``trace.blf`` (the same bytes at every
+record level, no wall-clock date in it), the figure a rerun is compared on.
 """
 
 from __future__ import annotations
@@ -32,8 +35,10 @@ import uuid
 from pathlib import Path
 from typing import Any
 
+from bench.campaign.zygote import Zygote
 from bench.operator.verdict import abnormal_events
-from bench.results.record import read_lines, run_file
+from bench.results.record import RECORD_STANDARD
+from bench.wire.trace import BLF_NAME
 from dbc.errors import RunError
 from dbc.records import write_record
 
@@ -41,10 +46,11 @@ EXIT_BAD_INPUT = 2
 PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 STOP_GRACE_S = 10.0
 """After SIGTERM, seconds a run gets to end its pair and write its folder before SIGKILL."""
-TRACE_HEADER = ("date", "Begin Triggerblock")
-"""ASC header lines that carry the wall-clock date (left out of the trace digest)."""
+DIGEST_CHUNK_BYTES = 1 << 20
 RESULT_FILE = "result.json"
 CASE_FILE = "case.json"
+STDERR_FILE = "stderr.log"
+"""The run's console output (its stderr: progress, notices, warnings), kept with the case."""
 ATTEMPT_MARK = ".attempt-"
 STATUS_OK, STATUS_ERROR, STATUS_REFUSED = "ok", "error", "refused"
 NO_ABNORMAL_EVENT = "no_abnormal_event"
@@ -58,9 +64,13 @@ class CaseTimeoutError(RunError):
     """The case's run was still going after its timeout (stopped; retried once)."""
 
 
-def run_command(scenario: Path, case: dict[str, Any], out: Path) -> list[str]:
-    """The ``thruster-hil run`` arguments that run ``case`` into ``out``."""
+def run_command(scenario: Path, case: dict[str, Any], out: Path,
+                record: str = RECORD_STANDARD) -> list[str]:
+    """The ``thruster-hil run`` arguments that run ``case`` into ``out`` (at the record
+    level ``record``, bench.results.record)."""
     cmd = ["run", str(scenario), "--seed", str(case["seed"]), "--no-plots", "--out", str(out)]
+    if record != RECORD_STANDARD:
+        cmd += ["--record", record]
     for o in case["overrides"]:
         cmd += ["--set", o]
     return cmd
@@ -72,17 +82,14 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child before e
 
 
 def trace_digest(run_dir: Path) -> str | None:
-    """SHA-256 of the run's CAN trace records (module docstring); None without a trace."""
-    try:
-        path = run_file(run_dir, "trace.asc")
-    except FileNotFoundError:
-        return None
+    """SHA-256 of the run's CAN trace, ``trace.blf`` (module docstring); None without one."""
+    path = run_dir / BLF_NAME
     if not path.exists():
         return None
     h = hashlib.sha256()
-    for line in read_lines(path):
-        if not line.startswith(TRACE_HEADER):
-            h.update(line.encode("utf-8"))
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(DIGEST_CHUNK_BYTES), b""):
+            h.update(chunk)
     return h.hexdigest()
 
 
@@ -135,7 +142,7 @@ def error_row(case: dict[str, Any], message: str, attempts: int = 1) -> dict[str
             "abnormal": [], "trace_sha256": None, "wall_time_s": None, "attempts": attempts}
 
 
-def _stop(p: subprocess.Popen[str]) -> None:
+def _stop(p: subprocess.Popen[bytes]) -> None:
     with contextlib.suppress(ProcessLookupError):
         os.killpg(p.pid, signal.SIGTERM)
     try:
@@ -146,37 +153,65 @@ def _stop(p: subprocess.Popen[str]) -> None:
         p.wait()
 
 
+def _run_cold(argv: list[str], env: dict[str, str], stderr: Path, timeout_s: float) -> int:
+    """``thruster-hil ARGV`` as a new interpreter; its exit code (TimeoutExpired: stopped)."""
+    with open(stderr, "wb") as err:
+        p = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", *argv], env=env,
+                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err,
+                             start_new_session=True, preexec_fn=_die_with_parent)
+    try:
+        return p.wait(timeout_s)
+    except BaseException:
+        _stop(p)
+        raise
+
+
+def _tail(path: Path) -> str:
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return "(no output)"
+    return " | ".join(text.strip().splitlines()[-STDERR_TAIL_LINES:]) or "(no output)"
+
+
 def run_case(case: dict[str, Any], scenario: str, cases_dir: str, timeout_s: float,
-             env_extra: dict[str, str], attempt: int = 1) -> dict[str, Any]:
+             env_extra: dict[str, str], attempt: int = 1, warm: str | Zygote | None = None,
+             record: str = RECORD_STANDARD) -> dict[str, Any]:
     """Run ``case`` of the campaign (module docstring); its result row (``attempt``: which
-    attempt this is, recorded in the row)."""
+    attempt this is, recorded in the row; ``warm``: the zygote that starts the run, or the
+    name of the Dask worker plugin whose zygote does, bench.campaign.warm_workers; None: a
+    new interpreter; ``record``: the run's record level, bench.results.record)."""
     final = Path(cases_dir) / case["name"]
     folder = Path(cases_dir) / f"{case['name']}{ATTEMPT_MARK}{uuid.uuid4().hex[:8]}"
     folder.mkdir(parents=True)
     write_record(folder / CASE_FILE, case)
     run_dir = folder / "run"
     env = dict(os.environ, **env_extra)
-    cmd = [sys.executable, "-m", "bench.operator.cli",
-           *run_command(Path(scenario), case, run_dir)]
-    p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                         text=True, start_new_session=True, preexec_fn=_die_with_parent)
+    argv = run_command(Path(scenario), case, run_dir, record)
+    stderr = folder / STDERR_FILE
+    zygote = warm if isinstance(warm, Zygote) else None
+    if isinstance(warm, str):
+        from bench.campaign.warm_workers import worker_zygote
+
+        zygote = worker_zygote(warm)
     try:
-        _, err = p.communicate(timeout=timeout_s)
+        if zygote is not None:
+            returncode = zygote.run(argv, env, stderr, timeout_s)
+        else:
+            returncode = _run_cold(argv, env, stderr, timeout_s)
     except subprocess.TimeoutExpired:
-        _stop(p)
         shutil.rmtree(folder, ignore_errors=True)
         raise CaseTimeoutError(f"case {case['name']}: still running after {timeout_s:g} s "
-                          "(stopped)") from None
+                               "(stopped)") from None
     except BaseException:
-        _stop(p)
         shutil.rmtree(folder, ignore_errors=True)
         raise
     summary = run_dir / "summary.json"
-    if p.returncode == EXIT_BAD_INPUT or not summary.exists():
-        tail = " | ".join(err.strip().splitlines()[-STDERR_TAIL_LINES:]) or "(no output)"
+    if returncode == EXIT_BAD_INPUT or not summary.exists():
+        tail = _tail(stderr)
         shutil.rmtree(folder, ignore_errors=True)
-        message = f"case {case['name']}: run exited {p.returncode}: {tail}"
-        if p.returncode == EXIT_BAD_INPUT:
+        message = f"case {case['name']}: run exited {returncode}: {tail}"
+        if returncode == EXIT_BAD_INPUT:
             return dict(error_row(case, message, attempt), status=STATUS_REFUSED)
         raise RunError(message)
     s = json.loads(summary.read_text(encoding="utf-8"))

@@ -3,10 +3,12 @@
 Reads the campaign file (:mod:`bench.campaign.spec`), builds and checks every case
 (:mod:`bench.campaign.cases`: each case's scenario is validated here, so an impossible
 dispersed vehicle is refused before any process starts, naming the case), runs them on
-Dask (:mod:`bench.campaign.engine`), keeps full traces only for failing and worst cases,
-and writes the tables and the report (:mod:`bench.campaign.report`). The console shows
-progress (cases done, pass rate so far, ETA), then each requirement's pass rate with its
-95 % interval, the wall time, cases per minute and the CPU used.
+Dask (:mod:`bench.campaign.engine`; each case recorded lean unless ``keep = "all"``:
+summary, events, 10 Hz telemetry and the trace as trace.blf, bench.results.record), keeps
+the trace only for failing and worst cases (a case's whole folder: ``thruster-hil campaign
+rerun``, exact), and writes the tables and the report (:mod:`bench.campaign.report`). The
+console shows progress (cases done, pass rate so far, ETA), then each requirement's pass
+rate with its 95 % interval, the wall time, cases per minute and the CPU used.
 
 The folder: ``campaign.toml`` and ``scenario.toml`` (copies: the campaign reruns from its
 folder alone), ``manifest.json`` (what the cases are: running the same campaign into the
@@ -37,7 +39,13 @@ from bench.campaign.engine import done_rows, run_cases
 from bench.campaign.report import write_html, write_tables
 from bench.campaign.spec import CASE_TIMEOUT_BASE_S, CampaignSpec, load_campaign
 from bench.campaign.stats import statistics
-from bench.results.record import read_lines, run_file
+from bench.results.record import (
+    LEAN_TELEMETRY_EVERY,
+    RECORD_LEAN,
+    RECORD_STANDARD,
+    read_lines,
+    run_file,
+)
 from bench.scenario.load import apply_overrides, override_of
 from bench.scenario.parse import parse_scenario
 from dbc.datafile import parse_toml, read_text
@@ -49,7 +57,6 @@ EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
 SCENARIO_COPY = "scenario.toml"
 CAMPAIGN_COPY = "campaign.toml"
 MANIFEST = "manifest.json"
-TELEMETRY_DECIMATION = 10
 """A pruned case keeps every this-many-th telemetry row (100 Hz -> 10 Hz)."""
 PRUNED = ("trace.asc", "trace.blf", "frames.csv", "chains.csv", "valve_pulses.csv")
 """Per-case files removed from cases that neither failed nor are among the worst."""
@@ -155,7 +162,8 @@ def _sha(text: str) -> str:
 
 
 def _decimate(run_dir: Path) -> None:
-    """Keep the header and every TELEMETRY_DECIMATION-th row, streamed (flat memory)."""
+    """Keep the header and every LEAN_TELEMETRY_EVERY-th row, streamed (flat memory): a
+    case recorded in full (by an earlier version) ends as a lean one does."""
     path = run_file(run_dir, "telemetry.csv")
     if not path.exists():
         return
@@ -163,13 +171,20 @@ def _decimate(run_dir: Path) -> None:
     opener = gzip.open if path.suffix == ".gz" else open
     with opener(tmp, "wt", encoding="utf-8") as f:
         f.writelines(line for i, line in enumerate(read_lines(path))
-                     if i == 0 or (i - 1) % TELEMETRY_DECIMATION == 0)
+                     if i == 0 or (i - 1) % LEAN_TELEMETRY_EVERY == 0)
     tmp.replace(path)
 
 
+def case_record(keep: str) -> str:
+    """The record level of a campaign's cases: ``lean`` unless every case keeps its whole
+    folder (bench.results.record: the summary is the same; the trace is trace.blf)."""
+    return RECORD_STANDARD if keep == "all" else RECORD_LEAN
+
+
 def prune(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any], keep: str) -> int:
-    """Drop full traces of passing cases that are not among the worst; decimate their
-    telemetry. The number of cases pruned."""
+    """Drop the trace of passing cases that are not among the worst (and the tables of a
+    case recorded in full, decimating its telemetry as a lean record does). The number of
+    cases pruned."""
     if keep == "all":
         return 0
     worst = {w["name"] for ws in stats["worst"].values() for w in ws}
@@ -180,11 +195,13 @@ def prune(out: Path, rows: list[dict[str, Any]], stats: dict[str, Any], keep: st
             continue
         if not (out / "cases" / r["name"] / RESULT_FILE).exists():
             continue
+        full = run_file(run_dir, "trace.asc").exists()
         for base in PRUNED:
             p = run_file(run_dir, base)
             if p.exists():
                 p.unlink()
-        _decimate(run_dir)
+        if full:
+            _decimate(run_dir)
         n += 1
     return n
 
@@ -263,7 +280,8 @@ def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str
         say(f"resuming: {resumed} of {len(cases)} cases already complete in {out}")
     cpu0, t0 = os.times(), time.monotonic()
     rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, n_workers,
-                     _progress(), notice=lambda line: say(line, err=True))
+                     _progress(), notice=lambda line: say(line, err=True),
+                     record=case_record(spec.keep))
     wall = time.monotonic() - t0
     cpu1 = os.times()
     cpu_s = ((cpu1.children_user - cpu0.children_user)
@@ -337,6 +355,6 @@ def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
         raise RunError(f"rerun of {name} did not complete (exit {p.returncode})")
     got = trace_digest(run_dir)
     same = got == row["trace_sha256"]
-    print(f"rerun {name}: trace records {'identical to' if same else 'DIFFERENT from'} the "
-          f"campaign's (sha256 {got}); {run_dir}")
+    print(f"rerun {name}: trace {'identical to' if same else 'DIFFERENT from'} the "
+          f"campaign's (trace.blf sha256 {got}); {run_dir}")
     return EXIT_OK if same else EXIT_FAILED

@@ -1,7 +1,9 @@
 """Run a campaign's cases on Dask: a local cluster sized to the machine, or a scheduler.
 
 One Dask task is one case (:func:`bench.campaign.case_run.run_case`: one ``thruster-hil
-run`` process, its bench + flight-software pair on a channel of its own). With no
+run`` process, its bench + flight-software pair on a channel of its own), started warm by
+the worker's zygote (bench.campaign.warm_workers: a worker plugin, taken off the workers
+when the campaign ends). With no
 scheduler, a ``distributed.LocalCluster`` of one single-threaded worker process per CPU
 (``available_cpus``) is started and closed with the campaign; ``scheduler`` =
 ``tcp://HOST:PORT`` sends the cases to a cluster started with Dask's own commands
@@ -41,6 +43,7 @@ from bench.campaign.case_run import (
     error_row,
     run_case,
 )
+from bench.results.record import RECORD_STANDARD
 from dbc.errors import ConfigError
 from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
@@ -84,6 +87,12 @@ def _sigint_ignored() -> Iterator[None]:
         signal.signal(signal.SIGINT, old)
 
 
+def _unregister(client: Any, name: str) -> None:
+    """Take the campaign's zygotes off the workers (they end with it)."""
+    with contextlib.suppress(Exception):  # a cluster already gone has none left
+        client.unregister_worker_plugin(name)
+
+
 def _connect(client_cls: Any, scheduler: str) -> Any:
     """A client of the scheduler at ``scheduler``, or a ConfigError saying why not."""
     try:
@@ -97,9 +106,13 @@ def _connect(client_cls: Any, scheduler: str) -> Any:
 def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s: float,
               scheduler: str | None = None, workers: int | None = None,
               progress: Progress | None = None,
-              notice: Callable[[str], None] = print) -> list[dict[str, Any]]:
-    """Every case's row, in case order (module docstring)."""
+              notice: Callable[[str], None] = print,
+              record: str = RECORD_STANDARD) -> list[dict[str, Any]]:
+    """Every case's row, in case order (module docstring; ``record``: the cases' record
+    level, bench.results.record)."""
     from distributed import Client, LocalCluster, as_completed
+
+    from bench.campaign.warm_workers import ZygotePlugin
 
     cases_dir = out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
@@ -130,11 +143,14 @@ def run_cases(cases: list[dict[str, Any]], scenario: Path, out: Path, timeout_s:
         else:
             client = stack.enter_context(_connect(Client, scheduler))
         token = uuid.uuid4().hex[:8]  # keys unique on a shared scheduler
+        plugin = ZygotePlugin(token)  # each worker starts its cases warm
+        client.register_plugin(plugin)
+        stack.callback(_unregister, client, plugin.name)
 
         def submit(c: dict[str, Any], attempt: int) -> Any:
             return client.submit(run_case, c, str(scenario), str(cases_dir), timeout_s, env,
-                                 attempt, key=f"case-{c['name']}-{token}-{attempt}",
-                                 pure=False)
+                                 attempt, plugin.name, record,
+                                 key=f"case-{c['name']}-{token}-{attempt}", pure=False)
 
         futures = {submit(c, 1): (c, 1) for c in todo}
         done = len(rows)

@@ -11,15 +11,24 @@ draws the plots afterwards (bench.operator.partial.plot_folder).
 from __future__ import annotations
 
 import gc
+import io
 import os
 import signal
 import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from bench.node import BenchNode
-from bench.operator.fsw_process import die_with_parent, fsw_argv, fsw_report, log_tail, stop
+from bench.operator.fsw_process import (
+    FswProcess,
+    die_with_parent,
+    fsw_argv,
+    fsw_report,
+    log_tail,
+    stop,
+)
 from bench.operator.lifecycle import DiskReserve, Stopped
 from bench.operator.run_warnings import (
     bus_warnings,
@@ -29,6 +38,7 @@ from bench.operator.run_warnings import (
     scenario_warnings,
 )
 from bench.operator.verdict import abnormal, verdict
+from bench.operator.warm_start import fork_program, run_module, warm_module
 from bench.results.counts import merge_counts, zero_unheard
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
@@ -42,20 +52,33 @@ if TYPE_CHECKING:
     from bench.operator.orchestrator import RunOptions
 
 
-def _start_fsw(opts: RunOptions, config: Path, stats: Path) -> subprocess.Popen[bytes]:
-    """The flight-software child, its output in ``fsw.log``, its pid in ``fsw.pid``."""
+def _start_fsw(opts: RunOptions, config: Path, stats: Path) -> FswProcess:
+    """The flight-software child, its output in ``fsw.log``, its pid in ``fsw.pid``: started
+    warm (forked, bench.operator.warm_start) where this process may and can, else by its
+    command line."""
     out = opts.out
     assert opts.fsw_cmd is not None
+    argv = fsw_argv(opts.fsw_cmd, opts.bus, opts.mode, out, config, stats)
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    module = warm_module(argv, env)
     with open(out / "fsw.log", "wb") as log:  # the child keeps its own copy
-        proc = subprocess.Popen(
-            fsw_argv(opts.fsw_cmd, opts.bus, opts.mode, out, config, stats),
-            stdout=log,
-            stderr=subprocess.STDOUT,
-            env=dict(os.environ, PYTHONUNBUFFERED="1"),
-            preexec_fn=die_with_parent,
-        )
+        proc: FswProcess
+        if module is not None:
+            proc = fork_program(run_module(module, argv[3:]), log.fileno(), log.fileno(),
+                                in_child=_unbuffered_fsw)
+        else:
+            proc = subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, env=env,
+                                    preexec_fn=die_with_parent)
     (out / "fsw.pid").write_text(f"{proc.pid}\n", encoding="utf-8")
     return proc
+
+
+def _unbuffered_fsw() -> None:  # pragma: no cover - runs in the warm child
+    """The warm child as PYTHONUNBUFFERED makes a cold one: each write reaches fsw.log."""
+    die_with_parent()
+    for f in (sys.stdout, sys.stderr):
+        if isinstance(f, io.TextIOWrapper):
+            f.reconfigure(line_buffering=True, write_through=True)
 
 
 def run_bench(
@@ -76,7 +99,7 @@ def run_bench(
     out = opts.out
     stats = out / "fsw_stats.json"
     bus = open_bus(opts.bus, **mode_options(opts.bus, opts.mode))
-    proc: subprocess.Popen[bytes] | None = None
+    proc: FswProcess | None = None
     try:
         if opts.fsw_cmd is not None:  # first: it boots while the bench node is built
             proc = _start_fsw(opts, config, stats)

@@ -264,7 +264,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="run folder, new or empty (default: runs/<scenario>-<time>-<hex>, "
                        "a new folder)")
         r.add_argument("--record", type=opt.choice("--record", RECORD_CHOICES),
-                       default=RECORD_STANDARD, metavar="{standard,full}",
+                       default=RECORD_STANDARD, metavar="{standard,full,lean}",
                        help="standard: the CAN trace and the CSV tables gzip-compressed "
                        "(trace.asc.gz, telemetry.csv.gz, ...: about a fifth of the size); "
                        "full: the same files as plain text (default standard); both also "

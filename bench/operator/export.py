@@ -41,7 +41,7 @@ from typing import Any
 import can
 from cantools.database.can import Database
 
-from bench.results.record import run_file
+from bench.results.record import trace_file
 from dbc.errors import ConfigError
 
 FORMATS = ("csv", "mf4", "parquet")
@@ -77,7 +77,7 @@ def decode_trace(run_dir: Path, db: Database) -> Decoded:
     """Every frame of ``run_dir``'s trace decoded with ``db`` (module docstring)."""
     if not run_dir.is_dir():
         raise ConfigError("command line", "RUN_DIR", str(run_dir), "an existing run folder")
-    path = run_file(run_dir, "trace.asc")
+    path = trace_file(run_dir)
     if not path.exists():
         raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace "
                           "(a campaign keeps it for failing and worst cases only: `thruster-hil "

@@ -22,7 +22,7 @@ import string
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from bench.operator.analysis.reception import RX_LOG_FILE
 from dbc.contract import REFUSAL_SCHEMA, FswRefusal
@@ -88,7 +88,26 @@ def die_with_parent() -> None:
 
 
 
-def stop(proc: subprocess.Popen[bytes]) -> int | None:
+class FswProcess(Protocol):
+    """The flight-software child as the bench holds it: a ``subprocess.Popen`` (started by
+    its command) or a bench.operator.warm_start.ForkedProcess (started warm)."""
+
+    @property
+    def pid(self) -> int: ...
+
+    @property
+    def returncode(self) -> int | None: ...
+
+    def poll(self) -> int | None: ...
+
+    def wait(self, timeout: float | None = None) -> int: ...
+
+    def send_signal(self, sig: int) -> None: ...
+
+    def kill(self) -> None: ...
+
+
+def stop(proc: FswProcess) -> int | None:
     if proc.poll() is None:
         proc.send_signal(signal.SIGTERM)
         try:

@@ -35,7 +35,7 @@ import can
 from cantools.database.can import Database
 
 from bench.operator.fsw_process import DEFAULT_FSW_CMD, die_with_parent, fsw_argv, stop
-from bench.results.record import run_file
+from bench.results.record import trace_file
 from dbc.errors import ConfigError
 from dbc.icd import FSW, Icd
 from transport.spec import mode_options, open_bus
@@ -78,7 +78,7 @@ class _Cycle:
 
 def split_cycles(run_dir: Path, db: Database) -> tuple[list[can.Message], list[_Cycle]]:
     """The bench's frames before the first SYNC, and the recording cycle by cycle."""
-    path = run_file(run_dir, "trace.asc")
+    path = trace_file(run_dir)
     if not path.exists():
         raise ConfigError(str(run_dir), "trace.asc", None, "a run folder with its CAN trace "
                           "(a campaign keeps it for failing and worst cases only: `thruster-hil "

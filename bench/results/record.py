@@ -1,6 +1,6 @@
 """How much a run records, and the run folder's per-frame and telemetry files as text.
 
-Two levels (``thruster-hil run --record``, ``bench --record``):
+Three levels (``thruster-hil run --record``, ``bench --record``):
 
 * ``standard`` (the default): the CAN trace and the CSV tables (``trace.asc``,
   ``frames.csv``, ``telemetry.csv``, ``chains.csv``, ``valve_pulses.csv``) are written
@@ -9,10 +9,16 @@ Two levels (``thruster-hil run --record``, ``bench --record``):
   as it is (``can.LogReader``, ``python -m can.player``); for a tool that wants plain ASC
   (CANoe, SavvyCAN), ``gunzip trace.asc.gz``.
 * ``full``: the same files uncompressed.
+* ``lean`` (a campaign's cases, bench.campaign): ``telemetry.csv.gz`` at a tenth of the
+  rate (every :data:`LEAN_TELEMETRY_EVERY`-th instant) and the trace as ``trace.blf`` only:
+  no ``trace.asc``, ``frames.csv``, ``chains.csv`` or ``valve_pulses.csv``. The summary is
+  the same (its figures are streamed, never read back from the files); a case's whole
+  folder comes from running it again (``thruster-hil campaign rerun``: lockstep is exact).
+  About a third less of the bench's CPU time goes into the files (docs/campaigns.md).
 
-Both levels also write the trace in Vector's binary logging format, ``trace.blf``
-(bench.wire.trace; itself zlib-compressed, ~5 kB per simulated second), so CANoe and
-CANalyzer open any run's trace as it is.
+Every level writes the trace in Vector's binary logging format, ``trace.blf``
+(bench.wire.trace; itself zlib-compressed, ~5 kB per simulated second), the same bytes at
+every level, so CANoe and CANalyzer open any run's trace as it is.
 
 Sizes (``python benchmarks/run_resources.py --durations 600``, quickstart): about 19 kB per
 simulated second at ``standard`` (``trace.blf``'s 5 kB included), 79 kB at ``full`` (README,
@@ -43,7 +49,10 @@ from dbc.errors import ConfigError
 
 RECORD_STANDARD = "standard"
 RECORD_FULL = "full"
-RECORD_CHOICES = (RECORD_STANDARD, RECORD_FULL)
+RECORD_LEAN = "lean"
+RECORD_CHOICES = (RECORD_STANDARD, RECORD_FULL, RECORD_LEAN)
+LEAN_TELEMETRY_EVERY = 10
+"""At ``lean``, telemetry.csv keeps one instant in this many (10 Hz of the 100 Hz)."""
 GZ_SUFFIX = ".gz"
 # zlib level: 6 (zlib's default) makes the files ~4.5x smaller than plain text, level 1
 # ~3.7x; the compression runs while the flight software computes its cycle (deferred
@@ -65,7 +74,13 @@ def check_record(record: str, where: str = "--record") -> str:
 
 def file_name(base: str, record: str) -> str:
     """The name of the run-folder file ``base`` (e.g. ``telemetry.csv``) at level ``record``."""
-    return base + GZ_SUFFIX if check_record(record) == RECORD_STANDARD else base
+    return base if check_record(record) == RECORD_FULL else base + GZ_SUFFIX
+
+
+def writes_tables(record: str) -> bool:
+    """Whether level ``record`` writes trace.asc and the per-frame, chain and pulse tables
+    (every level but ``lean``)."""
+    return check_record(record) != RECORD_LEAN
 
 
 def run_file(run_dir: Path, base: str) -> Path:
@@ -109,6 +124,17 @@ class _OwningText(io.TextIOWrapper):
         if not self.closed:
             super().close()  # writes the gzip trailer
             self._raw.close()
+
+
+def trace_file(run_dir: Path) -> Path:
+    """The run's CAN trace to read: ``trace.asc`` as written (plain or ``.gz``), else
+    ``trace.blf`` (a lean record's only trace; python-can reads both), else the missing
+    ``trace.asc``."""
+    asc = run_file(run_dir, "trace.asc")
+    if asc.exists():
+        return asc
+    blf = run_dir / "trace.blf"
+    return blf if blf.exists() else asc
 
 
 def read_lines(path: Path) -> Iterator[str]:

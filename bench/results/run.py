@@ -6,9 +6,10 @@ cycle, the IMU sample a command was computed from, the last command's and the fi
 firing command's reception [ns] (-> ``chains.csv`` and the sensor-to-command latency),
 stalls, the lockstep cycle's wall time and its wait for the flight software [ns], the
 realtime plant's lag behind the wall clock [ns]. Out: ``telemetry.csv``, ``chains.csv``,
-``valve_pulses.csv`` (flushed as the run goes) and the bench's part of ``summary.json``
-(:meth:`Results.summary`), built from these and from the station, the wire and the
-receive path at the end.
+``valve_pulses.csv`` (flushed as the run goes; at the lean record level telemetry at a
+tenth of the rate and no chains or pulses, bench.results.record) and the bench's part of
+``summary.json`` (:meth:`Results.summary`), built from these and from the station, the
+wire and the receive path at the end.
 
 Units: times in the files and the summary in seconds, latencies in microseconds.
 """
@@ -21,7 +22,7 @@ from typing import Any
 from bench.results.counts import frame_table, merge_counts
 from bench.results.fsw_view import FswView
 from bench.results.metrics import latency_summary
-from bench.results.record import RECORD_FULL, file_name
+from bench.results.record import LEAN_TELEMETRY_EVERY, RECORD_FULL, file_name, writes_tables
 from bench.results.summary import expectations_and_metrics, net_translation
 from bench.results.telemetry import Telemetry
 from bench.results.writers import CHAIN_COLUMNS, PULSE_COLUMNS, TelemetryWriter
@@ -51,9 +52,15 @@ class Results:
         def path(base: str) -> Path:
             return run_dir / file_name(base, record)
 
-        self.telemetry = Telemetry(sc, path("telemetry.csv"), n_thrusters, deferred)
-        self.chains = TelemetryWriter(path("chains.csv"), CHAIN_COLUMNS, deferred)
-        self.pulses = TelemetryWriter(path("valve_pulses.csv"), PULSE_COLUMNS, deferred)
+        tables = writes_tables(record)
+        self.telemetry = Telemetry(sc, path("telemetry.csv"), n_thrusters, deferred,
+                                   1 if tables else LEAN_TELEMETRY_EVERY)
+        # chains.csv and valve_pulses.csv: not at the lean level (their figures are streamed)
+        self.chains: TelemetryWriter | None = None
+        self.pulses: TelemetryWriter | None = None
+        if tables:
+            self.chains = TelemetryWriter(path("chains.csv"), CHAIN_COLUMNS, deferred)
+            self.pulses = TelemetryWriter(path("valve_pulses.csv"), PULSE_COLUMNS, deferred)
         self.fsw = FswView(icd)
         self._open_delay_ns = open_delay_ns
         self.imu_tx_ns: dict[int, int] = {}
@@ -78,6 +85,8 @@ class Results:
     # -- as the run goes -------------------------------------------------------------
     def add_pulses(self, pulses: list[Pulse]) -> None:
         """Commanded valve pulses (valve_pulses.csv)."""
+        if self.pulses is None:
+            return
         for p in pulses:
             self.pulses.row([p[0], p[1], p[2]])
 
@@ -90,6 +99,8 @@ class Results:
         t_imu = self.imu_tx_ns.get(imu_counter)
         if t_imu is not None:
             self.latency_ns.add(t_cmd_ns - t_imu)
+        if self.chains is None:
+            return
         t_fire = NAN if t_fire_ns is None else t_fire_ns / NS_PER_S
         t_open = NAN if t_fire_ns is None else (t_fire_ns + self._open_delay_ns) / NS_PER_S
         self.chains.row([cycle, imu_counter, NAN if t_imu is None else t_imu / NS_PER_S,
@@ -104,20 +115,23 @@ class Results:
     def write_pending(self) -> None:
         """Format the deferred rows (lockstep: while the flight software computes)."""
         self.telemetry.writer.write_pending()
-        self.pulses.write_pending()
-        self.chains.write_pending()
+        for w in (self.pulses, self.chains):
+            if w is not None:
+                w.write_pending()
 
     def flush(self) -> None:
         """Flush the files to disk."""
         self.telemetry.writer.flush()
-        self.pulses.flush()
-        self.chains.flush()
+        for w in (self.pulses, self.chains):
+            if w is not None:
+                w.flush()
 
     def close(self) -> None:
         """Finish the files."""
         self.telemetry.writer.close()
-        self.pulses.close()
-        self.chains.close()
+        for w in (self.pulses, self.chains):
+            if w is not None:
+                w.close()
 
     # -- at the end ------------------------------------------------------------------
     def summary(self, sim_time_s: float, station: Station, wire: Wire,

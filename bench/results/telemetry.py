@@ -50,8 +50,12 @@ def telemetry_columns(n_thrusters: int) -> list[str]:
 class Telemetry:
     """telemetry.csv and the streamed error figures (:class:`ErrorStats`)."""
 
-    def __init__(self, sc: Scenario, path: Path, n_thrusters: int, deferred: bool) -> None:
+    def __init__(self, sc: Scenario, path: Path, n_thrusters: int, deferred: bool,
+                 every: int = 1) -> None:
+        """``every``: write one instant in this many (the error figures take every one)."""
         self.sc = sc
+        self.every = every
+        self._instants = 0
         columns = telemetry_columns(n_thrusters)
         self.writer = TelemetryWriter(path, columns, deferred,
                                       [TIME_FORMAT] + [VALUE_FORMAT] * (len(columns) - 1))
@@ -65,6 +69,8 @@ class Telemetry:
         """Sample the station at ``t_ns`` (a telemetry instant)."""
         s = station.plant.state
         sc = self.sc
+        write = self._instants % self.every == 0
+        self._instants += 1
         if sc.reference.kind == KIND_STEP:
             err = quat_error_deg(s[0:4], sc.q_target_BN)
             rate_err = math.sqrt(s[4] ** 2 + s[5] ** 2 + s[6] ** 2) * RAD_DEG
@@ -74,13 +80,14 @@ class Telemetry:
             err = attitude_error_deg(q_t, q_ref)
             dw = rate_error_B(q_t, (s[4], s[5], s[6]), q_ref, w_ref)
             rate_err = math.sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2) * RAD_DEG
-        thr = station.plant.thrusters
-        row: list[float | int] = [t_ns / NS_PER_S, *s[0:4], *s[4:13], err, rate_err]
-        row += fsw.estimate_row()
-        row += [thr.valves[k].thrust_N(t_ns) for k in range(station.n_thr)]
-        row.append(thr.total_propellant_kg)
-        row.append(len(station.faults.active))
-        self.writer.row(row)
+        if write:
+            thr = station.plant.thrusters
+            row: list[float | int] = [t_ns / NS_PER_S, *s[0:4], *s[4:13], err, rate_err]
+            row += fsw.estimate_row()
+            row += [thr.valves[k].thrust_N(t_ns) for k in range(station.n_thr)]
+            row.append(thr.total_propellant_kg)
+            row.append(len(station.faults.active))
+            self.writer.row(row)
         if t_ns >= self._start_ns:
             self.errors.add(t_ns / NS_PER_S, err, rate_err,
                             math.dist(s[7:10], sc.r_reference_N_m))

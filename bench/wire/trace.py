@@ -1,7 +1,8 @@
 """The wire's record of the bus: the CAN trace (Vector ASC and BLF), per-frame timing, events.
 
 File names are those of a full record; a standard one (the default) adds ``.gz`` to the
-trace and to ``frames.csv`` (bench.results.record).
+trace and to ``frames.csv``; a lean one (a campaign's cases) writes ``trace.blf`` and
+``events.jsonl`` only (bench.results.record).
 
 * ``trace.asc`` — every frame the bench sent or received, in wire order, with its
   modelled (lockstep) or measured (realtime) time of reception; Tx = sent by the bench.
@@ -43,7 +44,7 @@ from typing import IO, Any
 
 import can
 
-from bench.results.record import RECORD_FULL, file_name, open_writer
+from bench.results.record import RECORD_FULL, file_name, open_writer, writes_tables
 from bench.results.writers import TelemetryWriter
 
 NS_PER_S = 1e9
@@ -70,21 +71,25 @@ class TraceRecorder:
         self.deferred = deferred
         # (kind, t_ns, message or None, tx, event text): in trace order until written
         self._pending: list[tuple[int, int, can.Message | None, bool, str]] = []
-        self._writer = w = can.ASCWriter(open_writer(self.path), channel=1)
+        self._writer: can.ASCWriter | None = None
+        self._frames: TelemetryWriter | None = None
         self._blf = can.BLFWriter(run_dir / BLF_NAME, channel=1)
         self._blf.start_timestamp = 0.0  # run time, as in the ASC trace (docstring)
-        # The trigger block is dated when the run started (metadata, as the file's "date"
-        # line); frame times stay run time, relative to it. Left to python-can, it is dated
-        # from the first frame's timestamp: 1 Jan 1970 for a run that starts at t = 0.
-        start = datetime.fromtimestamp(start_wall_s)
-        date = start.strftime(w.FORMAT_DATE.format(start.microsecond // US_PER_MS))
-        w.file.write(f"Begin Triggerblock {date}\n")
-        w.header_written = True
-        w.started = w.last_timestamp = 0.0
-        w.log_event("Start of measurement")
+        if writes_tables(record):
+            self._writer = w = can.ASCWriter(open_writer(self.path), channel=1)
+            # The trigger block is dated when the run started (metadata, as the file's
+            # "date" line); frame times stay run time, relative to it. Left to python-can,
+            # it is dated from the first frame's timestamp: 1 Jan 1970 for a run that
+            # starts at t = 0.
+            start = datetime.fromtimestamp(start_wall_s)
+            date = start.strftime(w.FORMAT_DATE.format(start.microsecond // US_PER_MS))
+            w.file.write(f"Begin Triggerblock {date}\n")
+            w.header_written = True
+            w.started = w.last_timestamp = 0.0
+            w.log_event("Start of measurement")
+            self._frames = TelemetryWriter(run_dir / file_name("frames.csv", record),
+                                           FRAME_COLUMNS, deferred)
         self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
-        self._frames = TelemetryWriter(run_dir / file_name("frames.csv", record),
-                                       FRAME_COLUMNS, deferred)
         self.frames_written = 0
         #: called with (t_ns, event, fields) for every event (bench.operator.alerts)
         self.listener: Callable[[int, str, dict[str, Any]], None] | None = None
@@ -101,11 +106,12 @@ class TraceRecorder:
         if msg.is_error_frame:
             self.error_frame(t_ns)
             return
-        data = msg.data
-        counter = data[1] & COUNTER_MASK if len(data) > 1 else -1
-        self._frames.row([t_ready_ns / NS_PER_S, t_start_ns / NS_PER_S,
-                          (t_ns if t_rx_ns is None else t_rx_ns) / NS_PER_S,
-                          msg.arbitration_id, msg.dlc, bits, int(tx), counter])
+        if self._frames is not None:
+            data = msg.data
+            counter = data[1] & COUNTER_MASK if len(data) > 1 else -1
+            self._frames.row([t_ready_ns / NS_PER_S, t_start_ns / NS_PER_S,
+                              (t_ns if t_rx_ns is None else t_rx_ns) / NS_PER_S,
+                              msg.arbitration_id, msg.dlc, bits, int(tx), counter])
         self.frames_written += 1
         if self.deferred:
             self._pending.append((PENDING_FRAME, t_ns, msg, tx, ""))
@@ -124,7 +130,8 @@ class TraceRecorder:
             is_rx=not tx,
             channel=0,
         )
-        self._writer.on_message_received(record)
+        if self._writer is not None:
+            self._writer.on_message_received(record)
         self._blf.on_message_received(record)
 
     def error_frame(self, t_ns: int) -> None:
@@ -137,11 +144,13 @@ class TraceRecorder:
 
     def _write_error(self, t_ns: int) -> None:
         record = can.Message(timestamp=t_ns / NS_PER_S, is_error_frame=True, channel=0)
-        self._writer.on_message_received(record)
+        if self._writer is not None:
+            self._writer.on_message_received(record)
         self._blf.on_message_received(record)
 
     def _write_event(self, t_ns: int, line: str) -> None:
-        self._writer.log_event(line, t_ns / NS_PER_S)
+        if self._writer is not None:
+            self._writer.log_event(line, t_ns / NS_PER_S)
         self._blf.log_event(line, t_ns / NS_PER_S)
 
     def event(self, t_ns: int, what: str, /, **fields: Any) -> None:
@@ -169,20 +178,25 @@ class TraceRecorder:
             else:
                 self._write_event(t_ns, line)
         self._pending.clear()
-        self._frames.write_pending()
+        if self._frames is not None:
+            self._frames.write_pending()
 
     def flush(self) -> None:
         """Flush the trace and the frame timing to disk."""
         self.write_pending()
-        self._writer.file.flush()
-        self._frames.flush()
+        if self._writer is not None:
+            self._writer.file.flush()
+        if self._frames is not None:
+            self._frames.flush()
 
     def close(self) -> None:
         """Finish every file."""
         self.write_pending()
-        self._writer.stop()
+        if self._writer is not None:
+            self._writer.stop()
         self._blf.stop()
-        self._frames.close()
+        if self._frames is not None:
+            self._frames.close()
         self._events.close()
 
 

@@ -164,3 +164,31 @@ def test_full_record_is_the_standard_one_uncompressed(
                                                               b.is_rx)
                and abs(a.timestamp - b.timestamp) <= ASC_RESOLUTION_S
                for a, b in zip(asc, blf, strict=True))
+
+
+# what a lean record leaves out; its summary figures are those of the standard record
+LEAN_ABSENT = ("trace.asc", "frames.csv", "chains.csv", "valve_pulses.csv")
+WALL_CLOCK_KEYS = ("record", "bus", "wall_time_s", "realtime_factor", "lockstep_wall_us",
+                   "fsw")
+
+
+def test_lean_record_keeps_the_summary_the_blf_and_a_tenth_of_the_telemetry(
+    quickstart: Run, tmp_path: Path, runtime_dir: Path
+) -> None:
+    """--record lean (a campaign's cases): the same summary but for wall-clock figures, the
+    same trace.blf bytes, the telemetry's every tenth instant, and none of the tables."""
+    from bench.results.record import LEAN_TELEMETRY_EVERY
+
+    lean = run_cli(["run", str(QUICKSTART), "--bus", unique_bus(), "--record", "lean",
+                    "--no-plots"], tmp_path / "lean", runtime_dir)
+    assert lean.returncode == 0, lean.stderr
+    s, ref = lean.summary, quickstart.summary
+    assert s["record"] == "lean"
+    assert {k: v for k, v in s.items() if k not in WALL_CLOCK_KEYS} == {
+        k: v for k, v in ref.items() if k not in WALL_CLOCK_KEYS}
+    assert (lean.out / "trace.blf").read_bytes() == (quickstart.out / "trace.blf").read_bytes()
+    rows = run_text(quickstart.out, "telemetry.csv").splitlines()
+    assert run_text(lean.out, "telemetry.csv").splitlines() == (
+        rows[:1] + rows[1::LEAN_TELEMETRY_EVERY])
+    for name in LEAN_ABSENT:
+        assert not list(lean.out.glob(name + "*")), name

@@ -74,7 +74,8 @@ def test_prune_drops_a_passing_case_trace_and_keeps_every_tenth_row(tmp_path: Pa
     and rows 0, 10, 20; a failing case untouched."""
     import gzip
 
-    from bench.campaign.cli import TELEMETRY_DECIMATION, prune
+    from bench.campaign.cli import prune
+    from bench.results.record import LEAN_TELEMETRY_EVERY
 
     rows = []
     for name, passed in (("0000", True), ("0001", False)):
@@ -90,7 +91,28 @@ def test_prune_drops_a_passing_case_trace_and_keeps_every_tenth_row(tmp_path: Pa
     assert prune(tmp_path, rows, {"worst": {}}, "failing") == 1
     kept = tmp_path / "cases" / "0000" / "run"
     with gzip.open(kept / "telemetry.csv.gz", "rt", encoding="utf-8") as f:
-        assert f.read().split() == ["t_s", *(str(i) for i in range(0, 25, TELEMETRY_DECIMATION))]
+        assert f.read().split() == ["t_s", *(str(i) for i in range(0, 25, LEAN_TELEMETRY_EVERY))]
     assert not (kept / "trace.asc.gz").exists() and not (kept / "trace.blf").exists()
     assert (tmp_path / "cases" / "0001" / "run" / "trace.asc.gz").exists()
     assert (tmp_path / "cases" / "0001" / "run" / "trace.blf").exists()
+
+
+def test_prune_leaves_a_lean_case_telemetry_as_it_is(tmp_path: Path) -> None:
+    """A passing lean case (no trace.asc: its telemetry already a tenth): only its trace.blf
+    goes; every telemetry row stays."""
+    import gzip
+
+    from bench.campaign.cli import prune
+
+    run = tmp_path / "cases" / "0000" / "run"
+    run.mkdir(parents=True)
+    (run.parent / "result.json").write_text("{}", encoding="utf-8")
+    rows_text = "t_s\n" + "".join(f"{i}\n" for i in range(25))
+    with gzip.open(run / "telemetry.csv.gz", "wt", encoding="utf-8") as f:
+        f.write(rows_text)
+    (run / "trace.blf").write_bytes(b"LOGG")
+    rows = [{"name": "0000", "status": "ok", "passed": True}]
+    assert prune(tmp_path, rows, {"worst": {}}, "failing") == 1
+    with gzip.open(run / "telemetry.csv.gz", "rt", encoding="utf-8") as f:
+        assert f.read() == rows_text
+    assert not (run / "trace.blf").exists()

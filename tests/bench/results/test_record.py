@@ -14,6 +14,7 @@ import pytest
 from bench.results.record import (
     GZ_SUFFIX,
     RECORD_FULL,
+    RECORD_LEAN,
     RECORD_STANDARD,
     check_record,
     file_name,
@@ -22,6 +23,8 @@ from bench.results.record import (
     read_lines,
     run_file,
     seal,
+    trace_file,
+    writes_tables,
 )
 from bench.results.writers import TelemetryWriter
 from bench.wire.trace import TraceRecorder
@@ -112,6 +115,9 @@ def test_levels_name_their_files_and_a_bad_level_is_refused() -> None:
     """standard adds .gz, full keeps the name; any other level is a ConfigError naming it."""
     assert file_name("trace.asc", RECORD_STANDARD) == "trace.asc.gz"
     assert file_name("trace.asc", RECORD_FULL) == "trace.asc"
+    assert file_name("telemetry.csv", RECORD_LEAN) == "telemetry.csv.gz"
+    assert [writes_tables(r) for r in (RECORD_STANDARD, RECORD_FULL, RECORD_LEAN)] == [
+        True, True, False]
     with pytest.raises(ConfigError, match="'fast'"):
         check_record("fast")
 
@@ -133,6 +139,26 @@ def test_trace_and_tables_of_either_level_read_back(tmp_path: Path, record: str)
     assert [m.timestamp for m in msgs] == [k * FRAME_PERIOD_NS / 1e9 for k in range(FRAMES)]
     frames = list(read_lines(run_file(tmp_path, "frames.csv")))
     assert len(frames) == FRAMES + 1  # and the header
+
+
+def test_a_lean_trace_is_the_blf_alone_with_the_standard_bytes(tmp_path: Path) -> None:
+    """At lean, the recorder writes trace.blf (byte for byte the standard level's) and the
+    events, no trace.asc and no frames table; trace_file then names the BLF."""
+    for record in (RECORD_STANDARD, RECORD_LEAN):
+        folder = tmp_path / record
+        folder.mkdir()
+        rec = TraceRecorder(folder, START_WALL_S, deferred=True, record=record)
+        for k in range(FRAMES):
+            rec.frame(can.Message(arbitration_id=0x100 + k % 3, data=bytes([k % 256, 1]),
+                                  is_extended_id=False), k * FRAME_PERIOD_NS, tx=k % 2 == 0)
+        rec.event(FRAMES * FRAME_PERIOD_NS, "fsw_silent", cycle=1)
+        rec.close()
+    lean, std = tmp_path / RECORD_LEAN, tmp_path / RECORD_STANDARD
+    assert (lean / "trace.blf").read_bytes() == (std / "trace.blf").read_bytes()
+    assert sorted(p.name for p in lean.iterdir()) == ["events.jsonl", "trace.blf"]
+    assert trace_file(lean) == lean / "trace.blf"
+    assert trace_file(std) == std / "trace.asc.gz"
+    assert len(list(can.LogReader(str(trace_file(lean))))) == FRAMES
 
 
 def test_telemetry_writer_compresses_by_name(tmp_path: Path) -> None:
