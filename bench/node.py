@@ -319,8 +319,10 @@ class BenchNode:
 
     # -- results ----------------------------------------------------------------------
     def summary(self, sim_time_s: float) -> dict[str, Any]:
-        """summary.json content from the bench's side."""
-        return self.results.summary(sim_time_s, self.station, self.wire, self.receipt)
+        """summary.json content from the bench's side (with the trace's digest)."""
+        summary = self.results.summary(sim_time_s, self.station, self.wire, self.receipt)
+        summary["trace_sha256"] = self.trace.digest()
+        return summary
 
     def close(self, sim_time_s: float) -> dict[str, Any]:
         """Finish files and write summary.json; returns the summary."""

@@ -16,15 +16,15 @@ a row with status ``"refused"``: not retried (the same input is refused again).
 Out: ``cases/NAME/case.json`` (the case: overrides, seed, the command that reproduces it)
 and ``cases/NAME/result.json`` (the row: :func:`result_row`), beside the run folder's
 files in ``cases/NAME/run/`` and the run's console output, ``cases/NAME/stderr.log``.
-``trace_sha256`` is the SHA-256 of the CAN trace as ``trace.blf`` (the same bytes at every
-record level, no wall-clock date in it), the figure a rerun is compared on.
+``trace_sha256`` is the run's own digest of its CAN trace (summary.json, bench.wire.trace:
+the frames and trace events in order, whatever the record level or file format), the figure
+a rerun is compared on.
 """
 
 from __future__ import annotations
 
 import contextlib
 import ctypes
-import hashlib
 import json
 import os
 import shutil
@@ -38,7 +38,6 @@ from typing import Any
 from bench.campaign.zygote import Zygote
 from bench.operator.verdict import abnormal_events
 from bench.results.record import RECORD_STANDARD
-from bench.wire.trace import BLF_NAME
 from dbc.errors import RunError
 from dbc.records import write_record
 
@@ -46,7 +45,6 @@ EXIT_BAD_INPUT = 2
 PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 STOP_GRACE_S = 10.0
 """After SIGTERM, seconds a run gets to end its pair and write its folder before SIGKILL."""
-DIGEST_CHUNK_BYTES = 1 << 20
 RESULT_FILE = "result.json"
 CASE_FILE = "case.json"
 STDERR_FILE = "stderr.log"
@@ -81,18 +79,6 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child before e
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
-def trace_digest(run_dir: Path) -> str | None:
-    """SHA-256 of the run's CAN trace, ``trace.blf`` (module docstring); None without one."""
-    path = run_dir / BLF_NAME
-    if not path.exists():
-        return None
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(DIGEST_CHUNK_BYTES), b""):
-            h.update(chunk)
-    return h.hexdigest()
-
-
 def _metric(s: dict[str, Any], key: str) -> float | None:
     v = s.get(key)
     return float(v) if isinstance(v, int | float) and not isinstance(v, bool) else None
@@ -105,8 +91,7 @@ METRICS = ("settling_time_s", "steady_state_attitude_error_deg", "final_attitude
 """The figures every row carries (None where the run has none)."""
 
 
-def result_row(case: dict[str, Any], s: dict[str, Any], run_dir: Path,
-               attempt: int = 1) -> dict[str, Any]:
+def result_row(case: dict[str, Any], s: dict[str, Any], attempt: int = 1) -> dict[str, Any]:
     """A case's result: what it was, what its run reported, its requirements."""
     lat = (s.get("latency_us") or {}).get("sensor_to_command") or {}
     fdir = s.get("fdir") or {}
@@ -128,7 +113,7 @@ def result_row(case: dict[str, Any], s: dict[str, Any], run_dir: Path,
         "failure": failure, "passed": bool(s.get("passed")) and all(reqs.values()),
         "requirements": reqs, "figures": figures, "values": dict(case["values"]),
         "abnormal": events, "warnings": list(s.get("warnings") or []),
-        "trace_sha256": trace_digest(run_dir),
+        "trace_sha256": s.get("trace_sha256"),
         "wall_time_s": _metric(s, "wall_time_s"), "attempts": attempt,
     }
 
@@ -215,7 +200,7 @@ def run_case(case: dict[str, Any], scenario: str, cases_dir: str, timeout_s: flo
             return dict(error_row(case, message, attempt), status=STATUS_REFUSED)
         raise RunError(message)
     s = json.loads(summary.read_text(encoding="utf-8"))
-    row = result_row(case, s, run_dir, attempt)
+    row = result_row(case, s, attempt)
     write_record(folder / RESULT_FILE, row)
     if final.exists():  # an earlier attempt that finished after all: this one replaces it
         shutil.rmtree(final)

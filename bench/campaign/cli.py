@@ -57,6 +57,9 @@ EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_RUN_ERROR = 0, 1, 2, 3
 SCENARIO_COPY = "scenario.toml"
 CAMPAIGN_COPY = "campaign.toml"
 MANIFEST = "manifest.json"
+MANIFEST_FORMAT = 2
+"""The manifest's format: 2 since cases' ``trace_sha256`` is the run's own trace digest
+(summary.json; 1, unnamed, was the SHA-256 of trace.asc's lines)."""
 """A pruned case keeps every this-many-th telemetry row (100 Hz -> 10 Hz)."""
 PRUNED = ("trace.asc", "trace.blf", "frames.csv", "chains.csv", "valve_pulses.csv")
 """Per-case files removed from cases that neither failed nor are among the worst."""
@@ -137,12 +140,15 @@ def _prepare(out: Path, spec: CampaignSpec, text: str, cases: list[dict[str, Any
     # campaign with more or fewer cases of the same draws extends or trims this one)
     digests = {c["name"]: _sha(json.dumps(c, sort_keys=True)) for c in cases}
     new: dict[str, Any] = {"scenario_sha256": _sha(text), "keep": spec.keep,
-                           "worst": spec.worst}
+                           "worst": spec.worst, "format": MANIFEST_FORMAT}
     man = out / MANIFEST
     if man.exists():
         old = json.loads(man.read_text(encoding="utf-8"))
         why = next((f"{k} differs" for k in ("scenario_sha256", "keep", "worst")
                     if old.get(k) != new[k]), None)
+        if old.get("format") != MANIFEST_FORMAT:
+            why = ("its cases were run by an earlier version, whose trace digest was of "
+                   "trace.asc: a campaign cannot mix the two")
         why = why or next((f"case {n} differs" for n, d in digests.items()
                            if old.get("cases", {}).get(n, d) != d), None)
         if why is not None:
@@ -328,7 +334,7 @@ def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str
 def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
     """``thruster-hil campaign rerun DIR CASE``: run the case again from its case.json; exit
     0 if its trace records equal the campaign's (``trace_sha256``), 1 if not."""
-    from bench.campaign.case_run import CASE_FILE, trace_digest
+    from bench.campaign.case_run import CASE_FILE
 
     case_dir = campaign_dir / "cases" / name
     try:
@@ -353,8 +359,8 @@ def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
     p = subprocess.run(cmd, check=False)
     if not (run_dir / "summary.json").exists():
         raise RunError(f"rerun of {name} did not complete (exit {p.returncode})")
-    got = trace_digest(run_dir)
-    same = got == row["trace_sha256"]
+    got = json.loads((run_dir / "summary.json").read_text(encoding="utf-8")).get("trace_sha256")
+    same = got is not None and got == row["trace_sha256"]
     print(f"rerun {name}: trace {'identical to' if same else 'DIFFERENT from'} the "
-          f"campaign's (trace.blf sha256 {got}); {run_dir}")
+          f"campaign's (trace_sha256 {got}); {run_dir}")
     return EXIT_OK if same else EXIT_FAILED

@@ -27,6 +27,7 @@ from bench.campaign.cases import build_cases, with_defaults
 from bench.campaign.distributions import Sweep
 from bench.campaign.paths import expand, get_value, parse_key
 from bench.campaign.spec import ALIASES, CASE_TIMEOUT_BASE_S, CampaignSpec, Dispersion
+from bench.campaign.zygote import Zygote
 from bench.scenario.load import apply_overrides
 from bench.scenario.parse import parse_scenario
 from dbc.datafile import parse_toml, read_text
@@ -99,7 +100,8 @@ def margin_search(scenario: Path, key: str, toward: float, requirement: str, out
         case = {"index": len(steps), "name": f"{len(steps):02d}", "vehicle": 0, "seed": c.seed,
                 "overrides": list(c.overrides), "values": [list(v) for v in c.values],
                 "failure": None, "fault_time_s": 0.0}
-        row = run_case(case, str(out / "scenario.toml"), str(out / "steps"), timeout, {})
+        row = run_case(case, str(out / "scenario.toml"), str(out / "steps"), timeout, {},
+                       warm=zygote)
         if row["status"] != STATUS_OK:
             raise RunError(f"margin step {value:g}: {row['error']}")
         reqs = row["requirements"]
@@ -116,24 +118,25 @@ def margin_search(scenario: Path, key: str, toward: float, requirement: str, out
     result: dict[str, Any] = {"scenario": str(scenario), "overrides": list(overrides),
                               "key": key, "requirement": requirement,
                               "nominal": nominal, "toward": toward, "tolerance": tol}
-    if not passes(nominal):
-        result.update(boundary=None, nominal_fails=True, note="the nominal value fails ("
-                      + (", ".join(failed_at_nominal) or requirement) + "): no margin")
-    elif passes(toward):
-        result.update(boundary=None, note=f"still passes at {toward:g}: the margin is at "
-                      f"least {abs(toward - nominal):g}")
-    else:
-        lo, hi = nominal, toward
-        while abs(hi - lo) > tol and len(steps) < MAX_STEPS:
-            mid = 0.5 * (lo + hi)
-            if passes(mid):
-                lo = mid
-            else:
-                hi = mid
-        boundary = 0.5 * (lo + hi)
-        result.update(boundary=boundary, uncertainty=abs(hi - lo) / 2, last_pass=lo,
-                      first_fail=hi, margin=boundary - nominal,
-                      margin_relative=(boundary - nominal) / nominal if nominal else None)
+    with Zygote() as zygote:  # each step forked warm (bench.campaign.zygote)
+        if not passes(nominal):
+            result.update(boundary=None, nominal_fails=True, note="the nominal value fails ("
+                          + (", ".join(failed_at_nominal) or requirement) + "): no margin")
+        elif passes(toward):
+            result.update(boundary=None, note=f"still passes at {toward:g}: the margin is at "
+                          f"least {abs(toward - nominal):g}")
+        else:
+            lo, hi = nominal, toward
+            while abs(hi - lo) > tol and len(steps) < MAX_STEPS:
+                mid = 0.5 * (lo + hi)
+                if passes(mid):
+                    lo = mid
+                else:
+                    hi = mid
+            boundary = 0.5 * (lo + hi)
+            result.update(boundary=boundary, uncertainty=abs(hi - lo) / 2, last_pass=lo,
+                          first_fail=hi, margin=boundary - nominal,
+                          margin_relative=(boundary - nominal) / nominal if nominal else None)
     result.update(runs=len(steps), steps=steps)
     write_record(out / "margin.json", result)
     return result

@@ -25,6 +25,7 @@ from bench.campaign.case_run import CASE_FILE, STATUS_OK, run_case
 from bench.campaign.cases import with_defaults
 from bench.campaign.paths import get_value, leaf_key, leaf_path, parse_key, set_value, toml_value
 from bench.campaign.spec import CASE_TIMEOUT_BASE_S
+from bench.campaign.zygote import Zygote
 from bench.scenario.load import apply_overrides
 from bench.scenario.parse import parse_scenario
 from dbc.datafile import parse_toml, read_text
@@ -86,7 +87,7 @@ def minimize(campaign_dir: Path, name: str, out: Path,
                            f"(--max-runs); the trials so far are in {out / 'minimal.json'}")
         c = dict(case, index=len(trials), name=f"{len(trials):02d}",
                  overrides=kept + _overrides(base, chosen))
-        row = run_case(c, str(scenario), str(out / "trials"), timeout, {})
+        row = run_case(c, str(scenario), str(out / "trials"), timeout, {}, warm=zygote)
         if row["status"] != STATUS_OK:
             raise RunError(f"minimal failure of {name}, trial {len(trials)}: {row['error']}")
         trials.append({"folder": f"trials/{c['name']}",
@@ -97,24 +98,25 @@ def minimize(campaign_dir: Path, name: str, out: Path,
 
     out.mkdir(parents=True, exist_ok=True)
     result.update(campaign=str(campaign_dir), case=name, dispersed=len(values))
-    if not fails(values):
-        result.update(minimal=None, note="the case passes as drawn: nothing to minimise")
-    elif fails({}):
-        result.update(minimal={}, note="the case fails at nominal too: no dispersion is needed")
-    else:
-        chosen = dict(values)
-        groups: dict[str, list[str]] = {}
-        for k in values:
-            groups.setdefault(leaf_key(parse_key(CASE_FILE, "values", k)), []).append(k)
-        for keys in groups.values():  # whole dispersions first
-            trial = {k: v for k, v in chosen.items() if k not in keys}
-            if len(trial) < len(chosen) and fails(trial):
-                chosen = trial
-        for k in list(chosen):  # then single elements
-            trial = {x: v for x, v in chosen.items() if x != k}
-            if len(chosen) > 1 and fails(trial):
-                chosen = trial
-        result.update(minimal=chosen, note=None)
+    with Zygote() as zygote:  # each trial forked warm (bench.campaign.zygote)
+        if not fails(values):
+            result.update(minimal=None, note="the case passes as drawn: nothing to minimise")
+        elif fails({}):
+            result.update(minimal={}, note="the case fails at nominal too: no dispersion is needed")
+        else:
+            chosen = dict(values)
+            groups: dict[str, list[str]] = {}
+            for k in values:
+                groups.setdefault(leaf_key(parse_key(CASE_FILE, "values", k)), []).append(k)
+            for keys in groups.values():  # whole dispersions first
+                trial = {k: v for k, v in chosen.items() if k not in keys}
+                if len(trial) < len(chosen) and fails(trial):
+                    chosen = trial
+            for k in list(chosen):  # then single elements
+                trial = {x: v for x, v in chosen.items() if x != k}
+                if len(chosen) > 1 and fails(trial):
+                    chosen = trial
+            result.update(minimal=chosen, note=None)
     result.update(runs=len(trials), trials=trials)
     write_record(out / "minimal.json", result)
     return result

@@ -17,6 +17,7 @@ from distributed import get_worker
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from bench.campaign.zygote import Zygote
+from dbc.errors import RunError
 
 PLUGIN_PREFIX = "thruster-hil-zygote-"
 
@@ -52,9 +53,15 @@ class ZygotePlugin(WorkerPlugin):
 
 def worker_zygote(name: str) -> Zygote | None:
     """The zygote of plugin ``name`` on the Dask worker running this task; None outside a
-    worker or where the plugin is not registered (the case then starts cold)."""
+    worker, where the plugin is not registered, or where the zygote cannot start (the case
+    then starts cold: slower, the same result)."""
     try:
         plugin = get_worker().plugins.get(name)
     except ValueError:  # not in a worker
         return None
-    return plugin.zygote() if isinstance(plugin, ZygotePlugin) else None
+    if not isinstance(plugin, ZygotePlugin):
+        return None
+    try:
+        return plugin.zygote()
+    except RunError:
+        return None

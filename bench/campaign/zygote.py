@@ -15,9 +15,12 @@ when the child ends, ``{"exit": CODE}`` (a negative code: killed by that signal)
 
 Ends, and nothing outlives it: a caller that hangs up before its run ended gets that run
 stopped (SIGTERM to its session: the run's lifecycle still completes its folder); when the
-process that started the zygote dies, its stdin reaches end of file and the zygote stops
-every run it started, then exits; a child also gets SIGTERM if the zygote dies
-(``PR_SET_PDEATHSIG``). Results are the same as a cold run's, byte for byte (tested).
+process that started the zygote dies or closes it, its stdin reaches end of file and the
+zygote stops every run it started, then exits (a caller still waiting gives the run
+``STOP_GRACE_S`` to complete its folder, then RunError); a child also gets SIGTERM if the
+zygote dies (``PR_SET_PDEATHSIG``). A run whose environment sets the interpreter's start-up
+variables (``PYTHON*``) otherwise than the zygote's is started cold (exec). Results are the
+same as a cold run's, byte for byte (tested).
 """
 
 from __future__ import annotations
@@ -46,6 +49,9 @@ MAX_REQUEST_BYTES = 1 << 20
 START_TIMEOUT_S = 60.0  # the zygote's imports (or a fork) on a loaded machine
 STOP_GRACE_S = 10.0  # after SIGTERM, as bench.campaign.case_run gives a run
 LOG_TAIL_LINES = 5
+STARTUP_PREFIX = "PYTHON"
+SESSION_POLL_S = 0.02  # polling a stopped run's session for its end
+CLI_MODULE = "bench.operator.cli"
 
 
 def _fsw_module() -> str:
@@ -103,14 +109,26 @@ def _start(req: dict[str, Any]) -> int:
         os.environ.update(env)
         sys.argv = ["thruster-hil", *argv]
 
+    def entry() -> int:  # pragma: no cover - runs in the child
+        if _startup_env(env) != _startup_env(os.environ):  # the interpreter reads these
+            os.execve(sys.executable, [sys.executable, "-m", CLI_MODULE, *argv], env)
+        return main(argv)
+
     err = os.open(req["stderr"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o644)
     null = os.open(os.devnull, os.O_RDWR | os.O_CLOEXEC)
     try:
-        child = fork_program(lambda: main(argv), null, err, in_child, stdin_fd=null)
+        child = fork_program(entry, null, err, in_child, stdin_fd=null)
     finally:
         os.close(err)
         os.close(null)
-    return child.pid
+    return child.detach()  # reaped by the loop (SIGCHLD), not followed by a pidfd
+
+
+def _startup_env(env: dict[str, str] | os._Environ[str]) -> dict[str, str]:
+    """The variables a Python interpreter reads as it starts (PYTHONHASHSEED, PYTHONPATH,
+    PYTHONWARNINGS...): a run whose environment sets them otherwise than the zygote's is
+    started cold (exec), as its command would be."""
+    return {k: v for k, v in env.items() if k.startswith(STARTUP_PREFIX)}
 
 
 def _send(conn: socket.socket, record: dict[str, Any]) -> None:
@@ -121,6 +139,22 @@ def _send(conn: socket.socket, record: dict[str, Any]) -> None:
 def _stop_session(pid: int) -> None:
     with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(pid, signal.SIGTERM)
+
+
+def _wait_session(pid: int, within_s: float) -> bool:
+    """Whether the session ``pid`` leads has no process left, waiting up to ``within_s``
+    (another process's children: polled, there is no wait call for them)."""
+    deadline = time.monotonic() + within_s
+    while True:
+        try:
+            os.killpg(pid, 0)
+        except ProcessLookupError:
+            return True
+        except PermissionError:
+            return False
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(SESSION_POLL_S)
 
 
 def serve(path: Path) -> int:
@@ -146,8 +180,8 @@ def serve(path: Path) -> int:
                 conn, _ = listener.accept()
                 try:
                     pid = _start(_read_request(conn))
-                except (OSError, ValueError) as exc:
-                    _send(conn, {"error": str(exc)})
+                except Exception as exc:  # a bad request is answered, never fatal
+                    _send(conn, {"error": f"{type(exc).__name__}: {exc}"})
                     conn.close()
                     continue
                 conn.setblocking(True)
@@ -233,13 +267,20 @@ class Zygote:
             request = {"argv": argv, "env": env, "cwd": os.getcwd(), "stderr": str(stderr)}
             conn.sendall(json.dumps(request).encode() + b"\n")
             reader = _Lines(conn)
-            first = reader.record(START_TIMEOUT_S)
+            try:
+                first = reader.record(START_TIMEOUT_S)
+            except EOFError:
+                first = None
             if first is None or "pid" not in first:
                 raise RunError("the campaign's zygote did not start the run "
                                f"({(first or {}).get('error', self._log_tail())})")
             pid = int(first["pid"])
             try:
                 last = reader.record(timeout_s)
+            except EOFError:  # the zygote ended first: it stopped the run (SIGTERM)
+                _wait_session(pid, STOP_GRACE_S)
+                raise RunError("the campaign's zygote ended during the run (stopped; "
+                               f"{self._log_tail()})") from None
             except BaseException:
                 self._stop(pid, reader)
                 raise
@@ -252,13 +293,17 @@ class Zygote:
 
     @staticmethod
     def _stop(pid: int, reader: _Lines) -> None:
+        """SIGTERM to the run's session; SIGKILL if it has not ended (its exit answered)
+        within STOP_GRACE_S."""
         _stop_session(pid)
-        with contextlib.suppress(OSError, ValueError):
+        with contextlib.suppress(OSError, ValueError, EOFError):
             if reader.record(STOP_GRACE_S) is not None:
                 return
+        if _wait_session(pid, 0.0):
+            return
         with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(pid, signal.SIGKILL)
-        with contextlib.suppress(OSError, ValueError):
+        with contextlib.suppress(OSError, ValueError, EOFError):
             reader.record(STOP_GRACE_S)
 
     def close(self) -> None:
@@ -289,7 +334,8 @@ class _Lines:
         self.buf = b""
 
     def record(self, timeout_s: float) -> dict[str, Any] | None:
-        """The next record; None at the end of the stream or after ``timeout_s``."""
+        """The next record; None after ``timeout_s``; EOFError at the end of the stream (the
+        zygote gone)."""
         deadline = time.monotonic() + timeout_s
         while b"\n" not in self.buf:
             left = deadline - time.monotonic()
@@ -301,7 +347,7 @@ class _Lines:
             except TimeoutError:
                 return None
             if not chunk:
-                return None
+                raise EOFError("the zygote closed the connection")
             self.buf += chunk
         line, self.buf = self.buf.split(b"\n", 1)
         rec = json.loads(line)

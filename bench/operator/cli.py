@@ -267,8 +267,9 @@ def build_parser() -> argparse.ArgumentParser:
                        default=RECORD_STANDARD, metavar="{standard,full,lean}",
                        help="standard: the CAN trace and the CSV tables gzip-compressed "
                        "(trace.asc.gz, telemetry.csv.gz, ...: about a fifth of the size); "
-                       "full: the same files as plain text (default standard); both also "
-                       "write the trace as trace.blf")
+                       "full: the same files as plain text; lean (a campaign's cases): "
+                       "telemetry at 10 Hz and the trace as trace.blf only, no tables "
+                       "(default standard); every level writes trace.blf")
         r.add_argument("--no-plots", action="store_true",
                        help="leave out the PNG plots (~0.3 s sooner: no matplotlib, no "
                        "drawing); `thruster-hil report RUN_DIR` draws them later")

@@ -19,7 +19,7 @@ from bench.operator.report_html import read_events
 from bench.operator.verdict import abnormal, verdict
 from bench.results.counts import frame_table, merge_counts, zero_unheard
 from bench.results.error_stats import ErrorStats
-from bench.results.record import GZ_SUFFIX, read_lines, run_file, seal
+from bench.results.record import GZ_SUFFIX, read_lines, run_file, seal, writes_tables
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
 from dbc.database import load_database
@@ -92,7 +92,9 @@ def partial_summary(
         "valve_openings": None, "frames": frames, "rejected_other": other,
         "latency_us": {"sensor_to_command": {"p50": None, "p99": None, "max": None, "n": 0}},
         "deadline_misses": None, "faults": faults, "expectations": [], "passed": False,
-        "error": why, "partial": True,
+        "error": why if writes_tables(opts.record) else
+        f"{why}; the bench's frame counts are unknown (the lean record level keeps no "
+        "frames.csv)", "partial": True,
     }
     if refused is not None:
         summary["refused"] = refused

@@ -118,15 +118,18 @@ def plot_run(run_dir: Path, band_deg: float | None = None,
     if not tel or len(tel["t_s"]) == 0:
         return []
     n_thr = sum(1 for k in head if k.startswith("thrust_T"))
-    _, pulses = _read_columns(run_file(run_dir, "valve_pulses.csv"), PULSE_COLUMNS)
     marks = list(events)[:MAX_MARKED_EVENTS]
-    return draw_each([
+    figures: list[tuple[Path, Callable[[Path], None]]] = [
         (run_dir / "attitude_error.png",
          lambda p: _save(_attitude_error(tel, band_deg), p, marks)),
         (run_dir / "rates.png", lambda p: _save(_rates(tel), p, marks)),
-        (run_dir / "thruster_raster.png",
-         lambda p: _save(_raster(tel["t_s"], pulses, n_thr), p, marks)),
-    ])
+    ]
+    pulses_path = run_file(run_dir, "valve_pulses.csv")
+    if pulses_path.exists():  # not at the lean record level: no raster rather than an empty one
+        _, pulses = _read_columns(pulses_path, PULSE_COLUMNS)
+        figures.append((run_dir / "thruster_raster.png",
+                        lambda p: _save(_raster(tel["t_s"], pulses, n_thr), p, marks)))
+    return draw_each(figures)
 
 
 def draw_each(figures: list[tuple[Path, Callable[[Path], None]]]) -> list[Path]:

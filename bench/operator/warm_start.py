@@ -179,7 +179,15 @@ class ForkedProcess:
 
     def _ended(self, status: int) -> None:
         self.returncode = os.waitstatus_to_exitcode(status)
-        os.close(self._pidfd)
+        self.detach()
+
+    def detach(self) -> int:
+        """Stop following it (its pidfd closed: a parent that reaps its children itself,
+        the zygote, keeps none); its pid."""
+        if self._pidfd >= 0:
+            os.close(self._pidfd)
+            self._pidfd = -1
+        return self.pid
 
     def send_signal(self, sig: int) -> None:
         """Signal it, unless it has been reaped already."""
@@ -203,20 +211,28 @@ def fork_program(entry: Callable[[], object], stdout_fd: int, stderr_fd: int,
     e.g. a parent-death signal, a new session)."""
     for f in (sys.stdout, sys.stderr):  # nothing buffered here is written twice
         f.flush()
-    with signals_blocked():
-        pid = os.fork()
-        if pid == 0:  # pragma: no cover - the child (its effects are tested)
-            try:
-                if stdin_fd is not None:
-                    os.dup2(stdin_fd, 0)
-                os.dup2(stdout_fd, 1)
-                os.dup2(stderr_fd, 2)
-                reset_child()
-                if in_child is not None:
-                    in_child()
-            except BaseException:
-                with contextlib.suppress(BaseException):
-                    traceback.print_exc()
-                os._exit(EXIT_UNCAUGHT)
-            run_and_exit(entry)
-    return ForkedProcess(pid)
+    child: ForkedProcess | None = None
+    try:
+        with signals_blocked():
+            pid = os.fork()
+            if pid == 0:  # pragma: no cover - the child (its effects are tested)
+                try:
+                    if stdin_fd is not None:
+                        os.dup2(stdin_fd, 0)
+                    os.dup2(stdout_fd, 1)
+                    os.dup2(stderr_fd, 2)
+                    reset_child()
+                    if in_child is not None:
+                        in_child()
+                except BaseException:
+                    with contextlib.suppress(BaseException):
+                        traceback.print_exc()
+                    os._exit(EXIT_UNCAUGHT)
+                run_and_exit(entry)
+            child = ForkedProcess(pid)
+    except BaseException:  # a stop signal held while forking: the child goes with us
+        if child is not None:
+            child.kill()
+            child.wait()
+        raise
+    return child

@@ -25,6 +25,12 @@ trace and to ``frames.csv``; a lean one (a campaign's cases) writes ``trace.blf`
 * ``events.jsonl`` — one JSON object per event (faults, watchdog, stalls), flushed per line;
   the events of :data:`TRACE_EVENTS` also go into the trace as ASC event lines.
 
+``trace_sha256`` (summary.json, every record level): the SHA-256 of the trace's content in
+trace order, each frame as ``<q I B B`` (time [ns], ID, flags: 1 sent by the bench, 2
+extended ID, 4 remote, 8 error frame; DLC) and its data bytes, each trace event as its time
+and text: what a rerun is compared on (bench.campaign), independent of the file formats,
+their compression and the wall-clock date.
+
 Deferred writing (``deferred=True``, the lockstep bench): frames and trace lines are kept as
 values and formatted into the files by :meth:`TraceRecorder.write_pending` (also called by
 ``flush`` and ``close``), so that a bench can do the text formatting while the flight
@@ -36,7 +42,9 @@ No clock is read here: every timestamp is passed in (the trace's start date too)
 
 from __future__ import annotations
 
+import hashlib
 import json
+import struct
 from collections.abc import Callable
 from datetime import datetime
 from pathlib import Path
@@ -57,6 +65,9 @@ TRACE_EVENTS = frozenset({"fault_injected", "fault_cleared", "valve_watchdog",
 COUNTER_MASK = 0x0F
 FRAME_COLUMNS = ["t_ready_s", "t_start_s", "t_rx_s", "id", "dlc", "bits", "tx", "counter"]
 PENDING_FRAME, PENDING_ERROR, PENDING_EVENT = 0, 1, 2  # kinds of a deferred trace line
+DIGEST_FRAME = struct.Struct("<qIBB")  # time [ns], ID, flags, DLC (module docstring)
+DIGEST_EVENT = struct.Struct("<q")  # time [ns], then the event's text
+FLAG_TX, FLAG_EXTENDED, FLAG_REMOTE, FLAG_ERROR = 1, 2, 4, 8
 
 
 class TraceRecorder:
@@ -91,6 +102,7 @@ class TraceRecorder:
                                            FRAME_COLUMNS, deferred)
         self._events: IO[str] = open(run_dir / "events.jsonl", "w", encoding="utf-8")  # noqa: SIM115
         self.frames_written = 0
+        self._digest = hashlib.sha256()
         #: called with (t_ns, event, fields) for every event (bench.operator.alerts)
         self.listener: Callable[[int, str, dict[str, Any]], None] | None = None
 
@@ -106,6 +118,10 @@ class TraceRecorder:
         if msg.is_error_frame:
             self.error_frame(t_ns)
             return
+        flags = ((FLAG_TX if tx else 0) | (FLAG_EXTENDED if msg.is_extended_id else 0)
+                 | (FLAG_REMOTE if msg.is_remote_frame else 0))
+        self._digest.update(DIGEST_FRAME.pack(t_ns, msg.arbitration_id, flags, msg.dlc))
+        self._digest.update(bytes(msg.data))
         if self._frames is not None:
             data = msg.data
             counter = data[1] & COUNTER_MASK if len(data) > 1 else -1
@@ -137,6 +153,7 @@ class TraceRecorder:
     def error_frame(self, t_ns: int) -> None:
         """An error frame on the bus at ``t_ns`` (ASC ``ErrorFrame`` line)."""
         self.frames_written += 1
+        self._digest.update(DIGEST_FRAME.pack(t_ns, 0, FLAG_ERROR, 0))
         if self.deferred:
             self._pending.append((PENDING_ERROR, t_ns, None, False, ""))
         else:
@@ -163,10 +180,15 @@ class TraceRecorder:
         if what in TRACE_EVENTS:  # also in the CAN trace, as an ASC event line
             text = " ".join(f"{k}={v}" for k, v in fields.items() if k != "t_s")
             line = f"thruster-hil {what} {text}".rstrip()
+            self._digest.update(DIGEST_EVENT.pack(t_ns) + line.encode("utf-8"))
             if self.deferred:
                 self._pending.append((PENDING_EVENT, t_ns, None, False, line))
             else:
                 self._write_event(t_ns, line)
+
+    def digest(self) -> str:
+        """``trace_sha256`` of what was recorded so far (module docstring)."""
+        return self._digest.hexdigest()
 
     def write_pending(self) -> None:
         """Format what deferred writing kept into the files (in trace order); not flushed."""

@@ -96,7 +96,7 @@ from bench.operator.analysis.records import (
     _is_real,
 )
 from bench.operator.analysis.tables import ChainTable, FrameTable, read_csv_columns
-from bench.results.record import run_file
+from bench.results.record import RECORD_LEAN, run_file
 from bench.results.writers import CHAIN_COLUMNS
 from bench.wire.trace import FRAME_COLUMNS
 from dbc.codec import BITRATE_ATTRIBUTE, bitrate_bps
@@ -169,6 +169,10 @@ class RunTiming:
             raise RunError(f"{summary_path}: missing (not a run folder?)") from None
         except json.JSONDecodeError as exc:
             raise RunError(f"{summary_path}: not JSON ({exc})") from exc
+        if summary.get("record") == RECORD_LEAN:
+            raise RunError(f"{d}: recorded at the lean level (a campaign's case), which keeps "
+                           "no frames.csv: timing needs a standard record (run it again "
+                           "without --record lean, or `thruster-hil campaign rerun DIR CASE`)")
         db = load_database() if db is None else db
         bitrate = summary.get("bitrate_bps") or _dbc_bitrate_bps(db)
         frames = FrameTable.from_columns(read_csv_columns(run_file(d, "frames.csv"),

@@ -116,3 +116,20 @@ def test_prune_leaves_a_lean_case_telemetry_as_it_is(tmp_path: Path) -> None:
     with gzip.open(run / "telemetry.csv.gz", "rt", encoding="utf-8") as f:
         assert f.read() == rows_text
     assert not (run / "trace.blf").exists()
+
+
+def test_a_folder_of_an_earlier_digest_format_is_not_resumed(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A manifest without this version's format (its rows digested trace.asc): exit 2 saying
+    so, the folder left as it was."""
+    import json
+
+    f = _write(tmp_path, "")
+    out = tmp_path / "out"
+    out.mkdir()
+    old = {"scenario_sha256": "x", "keep": "failing", "worst": 5, "cases": {}}
+    (out / "manifest.json").write_text(json.dumps(old), encoding="utf-8")
+    code = main([str(f), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == EXIT_BAD_INPUT and "earlier version" in err, err
+    assert json.loads((out / "manifest.json").read_text(encoding="utf-8")) == old

@@ -161,6 +161,30 @@ def test_a_lean_trace_is_the_blf_alone_with_the_standard_bytes(tmp_path: Path) -
     assert len(list(can.LogReader(str(trace_file(lean))))) == FRAMES
 
 
+def test_the_trace_digest_is_the_frames_not_the_files(tmp_path: Path) -> None:
+    """trace_sha256: the same at every record level and any start date; one data byte, one
+    ns or the direction of one frame changed, another digest."""
+
+    def digest(record: str, start_s: float, k_changed: int = -1, what: str = "") -> str:
+        folder = tmp_path / f"{record}{start_s}{k_changed}{what}"
+        folder.mkdir()
+        rec = TraceRecorder(folder, start_s, deferred=True, record=record)
+        for k in range(FRAMES):
+            changed = k == k_changed
+            data = bytes([k % 256, 2 if changed and what == "data" else 1])
+            t_ns = k * FRAME_PERIOD_NS + (1 if changed and what == "time" else 0)
+            tx = (k % 2 == 0) != (changed and what == "tx")
+            rec.frame(can.Message(arbitration_id=0x100 + k % 3, data=data,
+                                  is_extended_id=False), t_ns, tx=tx)
+        rec.close()
+        return rec.digest()
+
+    ref = digest(RECORD_STANDARD, START_WALL_S)
+    assert digest(RECORD_LEAN, START_WALL_S) == ref == digest(RECORD_FULL, START_WALL_S + 1e5)
+    for what in ("data", "time", "tx"):
+        assert digest(RECORD_STANDARD, START_WALL_S, FRAMES // 2, what) != ref, what
+
+
 def test_telemetry_writer_compresses_by_name(tmp_path: Path) -> None:
     """TelemetryWriter on a .gz name writes the same text as on a plain one."""
     for name in ("t.csv", "t.csv.gz"):
