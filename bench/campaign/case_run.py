@@ -15,7 +15,7 @@ a row with status ``"refused"``: not retried (the same input is refused again).
 
 Out: ``cases/NAME/case.json`` (the case: overrides, seed, the command that reproduces it)
 and ``cases/NAME/result.json`` (the row: :func:`result_row`), beside the run folder's
-files in ``cases/NAME/run/`` and the run's console output, ``cases/NAME/stderr.log``.
+files in ``cases/NAME/run/`` and the run's console output, ``cases/NAME/console.log``.
 ``trace_sha256`` is the run's own digest of its CAN trace (summary.json, bench.wire.trace:
 the frames and trace events in order, whatever the record level or file format), the figure
 a rerun is compared on.
@@ -47,8 +47,9 @@ STOP_GRACE_S = 10.0
 """After SIGTERM, seconds a run gets to end its pair and write its folder before SIGKILL."""
 RESULT_FILE = "result.json"
 CASE_FILE = "case.json"
-STDERR_FILE = "stderr.log"
-"""The run's console output (its stderr: progress, notices, warnings), kept with the case."""
+CONSOLE_FILE = "console.log"
+"""The run's console output (stdout and stderr: progress, notices, warnings, the verdict),
+kept with the case."""
 ATTEMPT_MARK = ".attempt-"
 STATUS_OK, STATUS_ERROR, STATUS_REFUSED = "ok", "error", "refused"
 NO_ABNORMAL_EVENT = "no_abnormal_event"
@@ -63,10 +64,12 @@ class CaseTimeoutError(RunError):
 
 
 def run_command(scenario: Path, case: dict[str, Any], out: Path,
-                record: str = RECORD_STANDARD) -> list[str]:
+                record: str = RECORD_STANDARD, plots: bool = False) -> list[str]:
     """The ``thruster-hil run`` arguments that run ``case`` into ``out`` (at the record
-    level ``record``, bench.results.record)."""
-    cmd = ["run", str(scenario), "--seed", str(case["seed"]), "--no-plots", "--out", str(out)]
+    level ``record``, bench.results.record; with its plots if ``plots``)."""
+    cmd = ["run", str(scenario), "--seed", str(case["seed"]), "--out", str(out)]
+    if not plots:
+        cmd.insert(4, "--no-plots")
     if record != RECORD_STANDARD:
         cmd += ["--record", record]
     for o in case["overrides"]:
@@ -138,11 +141,11 @@ def _stop(p: subprocess.Popen[bytes]) -> None:
         p.wait()
 
 
-def _run_cold(argv: list[str], env: dict[str, str], stderr: Path, timeout_s: float) -> int:
+def _run_cold(argv: list[str], env: dict[str, str], console: Path, timeout_s: float) -> int:
     """``thruster-hil ARGV`` as a new interpreter; its exit code (TimeoutExpired: stopped)."""
-    with open(stderr, "wb") as err:
+    with open(console, "wb") as out:
         p = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", *argv], env=env,
-                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=err,
+                             stdin=subprocess.DEVNULL, stdout=out, stderr=out,
                              start_new_session=True, preexec_fn=_die_with_parent)
     try:
         return p.wait(timeout_s)
@@ -173,7 +176,7 @@ def run_case(case: dict[str, Any], scenario: str, cases_dir: str, timeout_s: flo
     run_dir = folder / "run"
     env = dict(os.environ, **env_extra)
     argv = run_command(Path(scenario), case, run_dir, record)
-    stderr = folder / STDERR_FILE
+    console = folder / CONSOLE_FILE
     zygote = warm if isinstance(warm, Zygote) else None
     if isinstance(warm, str):
         from bench.campaign.warm_workers import worker_zygote
@@ -181,9 +184,9 @@ def run_case(case: dict[str, Any], scenario: str, cases_dir: str, timeout_s: flo
         zygote = worker_zygote(warm)
     try:
         if zygote is not None:
-            returncode = zygote.run(argv, env, stderr, timeout_s)
+            returncode = zygote.run(argv, env, console, timeout_s)
         else:
-            returncode = _run_cold(argv, env, stderr, timeout_s)
+            returncode = _run_cold(argv, env, console, timeout_s)
     except subprocess.TimeoutExpired:
         shutil.rmtree(folder, ignore_errors=True)
         raise CaseTimeoutError(f"case {case['name']}: still running after {timeout_s:g} s "
@@ -193,7 +196,7 @@ def run_case(case: dict[str, Any], scenario: str, cases_dir: str, timeout_s: flo
         raise
     summary = run_dir / "summary.json"
     if returncode == EXIT_BAD_INPUT or not summary.exists():
-        tail = _tail(stderr)
+        tail = _tail(console)
         shutil.rmtree(folder, ignore_errors=True)
         message = f"case {case['name']}: run exited {returncode}: {tail}"
         if returncode == EXIT_BAD_INPUT:

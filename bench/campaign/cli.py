@@ -21,6 +21,7 @@ refused: the others still run); 3 a case could not complete.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import gzip
 import hashlib
@@ -28,14 +29,16 @@ import json
 import os
 import shlex
 import shutil
+import signal
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from bench.campaign.case_run import RESULT_FILE, STATUS_OK, STATUS_REFUSED, run_command
 from bench.campaign.cases import Case, build_cases
-from bench.campaign.engine import done_rows, run_cases
+from bench.campaign.engine import check_scheduler, done_rows, run_cases
 from bench.campaign.report import write_html, write_tables
 from bench.campaign.spec import CASE_TIMEOUT_BASE_S, CampaignSpec, load_campaign
 from bench.campaign.stats import statistics
@@ -163,6 +166,22 @@ def _prepare(out: Path, spec: CampaignSpec, text: str, cases: list[dict[str, Any
     write_record(man, dict(new, cases=digests))
 
 
+@contextlib.contextmanager
+def stop_signals_interrupt() -> Iterator[None]:
+    """SIGTERM and SIGHUP (a CI job cancelled, a closed terminal) stop the campaign as
+    Ctrl-C does: its Dask cluster closed, its zygotes ended, complete cases kept."""
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    old = {s: signal.signal(s, interrupt) for s in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
 def _sha(text: str) -> str:
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
@@ -276,6 +295,8 @@ def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str
     spec = load_campaign(path)
     text, cases, timeout = checked_cases(spec)
     check_fsw_config(spec.scenario, list(spec.overrides), spec.source)
+    if scheduler is not None:
+        check_scheduler(scheduler)  # before the folder is made: a typo leaves nothing
     _prepare(out, spec, text, cases)
     resumed = len(done_rows(out / "cases", cases))
     n_workers = min(workers or available_cpus(), max(1, len(cases) - resumed))
@@ -285,9 +306,16 @@ def run_campaign_file(path: Path, out: Path, workers: int | None, scheduler: str
     if resumed:
         say(f"resuming: {resumed} of {len(cases)} cases already complete in {out}")
     cpu0, t0 = os.times(), time.monotonic()
-    rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, n_workers,
-                     _progress(), notice=lambda line: say(line, err=True),
-                     record=case_record(spec.keep))
+    try:
+        with stop_signals_interrupt():
+            rows = run_cases(cases, out / SCENARIO_COPY, out, timeout, scheduler, n_workers,
+                             _progress(), notice=lambda line: say(line, err=True),
+                             record=case_record(spec.keep))
+    except KeyboardInterrupt:
+        done = len(done_rows(out / "cases", cases))
+        say(f"campaign stopped: {done} of {len(cases)} cases complete in {out}; the same "
+            "command resumes it", err=True)
+        raise
     wall = time.monotonic() - t0
     cpu1 = os.times()
     cpu_s = ((cpu1.children_user - cpu0.children_user)
@@ -352,10 +380,9 @@ def rerun_case(campaign_dir: Path, name: str, out: Path | None) -> int:
         run_dir = new_folder(out)
     import subprocess
 
-    cmd = [sys.executable, "-m", "bench.operator.cli",
-           *run_command(campaign_dir / SCENARIO_COPY, case, run_dir)]
-    print("rerun: " + " ".join(["thruster-hil", *_quoted(run_command(
-        campaign_dir / SCENARIO_COPY, case, run_dir))]), flush=True)
+    args = run_command(campaign_dir / SCENARIO_COPY, case, run_dir, plots=True)
+    cmd = [sys.executable, "-m", "bench.operator.cli", *args]
+    print("rerun: " + " ".join(["thruster-hil", *_quoted(args)]), flush=True)
     p = subprocess.run(cmd, check=False)
     if not (run_dir / "summary.json").exists():
         raise RunError(f"rerun of {name} did not complete (exit {p.returncode})")

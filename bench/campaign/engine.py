@@ -30,6 +30,7 @@ import json
 import logging
 import shutil
 import signal
+import socket
 import uuid
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -49,6 +50,8 @@ from transport.lockstep import LOCKSTEP_SPIN_ENV, available_cpus
 
 PROCESSES_PER_CASE = 2  # bench + flight software
 SCHEDULER_TIMEOUT_S = 30.0  # connecting to --scheduler
+SCHEDULER_PROBE_S = 5.0  # the first TCP connection to --scheduler (check_scheduler)
+TCP_SCHEME = "tcp://"
 RETRIES = 1
 DASK_LOG_LEVEL = logging.CRITICAL
 """Dask's own log lines (a failed task's traceback at ERROR) would bury the progress; the
@@ -91,6 +94,21 @@ def _unregister(client: Any, name: str) -> None:
     """Take the campaign's zygotes off the workers (they end with it)."""
     with contextlib.suppress(Exception):  # a cluster already gone has none left
         client.unregister_worker_plugin(name)
+
+
+def check_scheduler(scheduler: str) -> None:
+    """ConfigError at once if a ``tcp://HOST:PORT`` scheduler refuses connections (Dask's
+    own client would retry for SCHEDULER_TIMEOUT_S); other schemes are left to Dask."""
+    if not scheduler.startswith(TCP_SCHEME):
+        return
+    host, _, port = scheduler[len(TCP_SCHEME):].rpartition(":")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), SCHEDULER_PROBE_S):
+            return
+    except (OSError, ValueError) as exc:
+        raise ConfigError("command line", "--scheduler", scheduler,
+                          "the address of a running Dask scheduler, tcp://HOST:PORT (as "
+                          f"`python -m dask scheduler` prints it): {exc}") from exc
 
 
 def _connect(client_cls: Any, scheduler: str) -> Any:

@@ -82,7 +82,7 @@ def _minimize(args: argparse.Namespace) -> int:
         shutil.rmtree(out, ignore_errors=True)
     r = minimize(d, args.case, out, args.max_runs)
     if r["minimal"] is None or not r["minimal"]:
-        print(f"minimal failure of {args.case}: {r['note']} ({r['runs']} runs)")
+        print(f"minimal failure of {args.case}: {r['note']} ({_runs(r['runs'])})")
     else:
         print(f"minimal failure of {args.case}: {len(r['minimal'])} of {r['dispersed']} "
               f"dispersed values still fail ({r['runs']} runs; the rest at nominal):")
@@ -90,6 +90,10 @@ def _minimize(args: argparse.Namespace) -> int:
             print(f"  {k} = {v}")
     print(f"  {out / 'minimal.json'}")
     return 0
+
+
+def _runs(n: int) -> str:
+    return f"{n} run" if n == 1 else f"{n} runs"
 
 
 def main(argv: list[str]) -> int:
@@ -112,7 +116,7 @@ def main(argv: list[str]) -> int:
     except (ConfigError, RunError) as exc:
         return error_exit(exc)
     if r.get("boundary") is None:
-        print(f"margin of {r['key']} for {r['requirement']}: {r['note']} ({r['runs']} runs)")
+        print(f"margin of {r['key']} for {r['requirement']}: {r['note']} ({_runs(r['runs'])})")
         if r.get("nominal_fails"):
             return EXIT_FAILED
     else:

@@ -6,17 +6,18 @@ does its flight software: on 2 cores that is a fifth of a quickstart case. A zyg
 supervisor, the bench and the flight software's entry module once (``OPENBLAS_NUM_THREADS``
 1, as the flight software sets it: one BLAS thread per process, two processes per case),
 freezes what it has for the garbage collector, and serves requests on a Unix socket in a
-private folder: each connection sends one JSON line ``{"argv", "env", "cwd", "stderr"}``;
+private folder: each connection sends one JSON line ``{"argv", "env", "cwd", "console"}``;
 the zygote forks a child that runs ``thruster-hil ARGV`` as the command line would
 (bench.operator.warm_start: a session of its own, the environment ``env`` with
 ``THRUSTER_HIL_WARM_START=1`` so that its bench starts the flight software warm too, stdin
-/dev/null, stdout /dev/null, stderr to the file ``stderr``), answers ``{"pid": N}`` and,
+/dev/null, stdout and stderr to the file ``console``), answers ``{"pid": N}`` and,
 when the child ends, ``{"exit": CODE}`` (a negative code: killed by that signal).
 
 Ends, and nothing outlives it: a caller that hangs up before its run ended gets that run
 stopped (SIGTERM to its session: the run's lifecycle still completes its folder); when the
-process that started the zygote dies or closes it, its stdin reaches end of file and the
-zygote stops every run it started, then exits (a caller still waiting gives the run
+process that started the zygote dies or closes it (its stdin reaches end of file), or a
+SIGTERM or SIGHUP reaches it, the zygote stops every run it started, removes its folder
+(socket and log), then exits (a caller still waiting gives the run
 ``STOP_GRACE_S`` to complete its folder, then RunError); a child also gets SIGTERM if the
 zygote dies (``PR_SET_PDEATHSIG``). A run whose environment sets the interpreter's start-up
 variables (``PYTHON*``) otherwise than the zygote's is started cold (exec). Results are the
@@ -43,7 +44,7 @@ from typing import Any
 from dbc.errors import RunError
 
 READY = "ready"
-REQUEST_KEYS = ("argv", "env", "cwd", "stderr")
+REQUEST_KEYS = ("argv", "env", "cwd", "console")
 REQUEST_TIMEOUT_S = 10.0  # a connection has this long to send its request line
 MAX_REQUEST_BYTES = 1 << 20
 START_TIMEOUT_S = 60.0  # the zygote's imports (or a fork) on a loaded machine
@@ -51,6 +52,7 @@ STOP_GRACE_S = 10.0  # after SIGTERM, as bench.campaign.case_run gives a run
 LOG_TAIL_LINES = 5
 STARTUP_PREFIX = "PYTHON"
 SESSION_POLL_S = 0.02  # polling a stopped run's session for its end
+END_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 CLI_MODULE = "bench.operator.cli"
 
 
@@ -114,12 +116,12 @@ def _start(req: dict[str, Any]) -> int:
             os.execve(sys.executable, [sys.executable, "-m", CLI_MODULE, *argv], env)
         return main(argv)
 
-    err = os.open(req["stderr"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o644)
+    out = os.open(req["console"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_CLOEXEC, 0o644)
     null = os.open(os.devnull, os.O_RDWR | os.O_CLOEXEC)
     try:
-        child = fork_program(entry, null, err, in_child, stdin_fd=null)
+        child = fork_program(entry, out, out, in_child, stdin_fd=null)
     finally:
-        os.close(err)
+        os.close(out)
         os.close(null)
     return child.detach()  # reaped by the loop (SIGCHLD), not followed by a pidfd
 
@@ -173,7 +175,26 @@ def serve(path: Path) -> int:
     sel.register(wake_r, selectors.EVENT_READ, "child")
     sel.register(sys.stdin, selectors.EVENT_READ, "parent")
     runs: dict[int, socket.socket] = {}  # pid -> the connection that asked for it
-    print(READY, flush=True)
+    for s in END_SIGNALS:  # ends as its parent's end of file does: runs stopped, folder gone
+        signal.signal(s, _end)
+    try:
+        print(READY, flush=True)
+        _loop(listener, wake_r, sel, runs)
+    finally:
+        for pid in runs:
+            _stop_session(pid)
+        listener.close()
+        shutil.rmtree(path.parent, ignore_errors=True)  # its socket and log: nothing left
+    return 0
+
+
+def _end(signum: int, frame: object) -> None:
+    raise SystemExit(0)
+
+
+def _loop(listener: socket.socket, wake_r: socket.socket, sel: selectors.BaseSelector,
+          runs: dict[int, socket.socket]) -> None:
+    """Serve until the parent's end of file (module docstring)."""
     while True:
         for key, _ in sel.select():
             if key.data == "listen":
@@ -194,10 +215,8 @@ def serve(path: Path) -> int:
                         pass
                 _reap(runs, sel)
             elif key.data == "parent":
-                if not os.read(0, 4096):  # its parent is gone
-                    for pid in runs:
-                        _stop_session(pid)
-                    return 0
+                if not os.read(0, 4096):  # its parent is gone (or closed it)
+                    return
             else:  # a caller hung up (or sent more): its run is stopped
                 with contextlib.suppress(OSError):
                     if not key.fileobj.recv(4096):  # type: ignore[union-attr]
@@ -254,17 +273,18 @@ class Zygote:
         """Whether the zygote process is still running."""
         return self._proc.poll() is None
 
-    def run(self, argv: list[str], env: dict[str, str], stderr: Path,
+    def run(self, argv: list[str], env: dict[str, str], console: Path,
             timeout_s: float) -> int:
         """Run ``thruster-hil ARGV`` in a child of the zygote (environment ``env``, the
-        working folder this process's, stderr into the file ``stderr``); its exit code
+        working folder this process's, stdout and stderr into the file ``console``); its exit
+        code
         (negative: killed by that signal). After ``timeout_s`` it is stopped (SIGTERM to its
         session, SIGKILL after ``STOP_GRACE_S``) and ``subprocess.TimeoutExpired`` raised;
         so it is on any exception here (Ctrl-C)."""
         conn = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         with conn:
             conn.connect(str(self.path))
-            request = {"argv": argv, "env": env, "cwd": os.getcwd(), "stderr": str(stderr)}
+            request = {"argv": argv, "env": env, "cwd": os.getcwd(), "console": str(console)}
             conn.sendall(json.dumps(request).encode() + b"\n")
             reader = _Lines(conn)
             try:

@@ -3,7 +3,7 @@
 Subcommands: ``run SCENARIO`` (bench + flight software as two processes, lockstep or
 realtime), ``bench SCENARIO`` (the bench alone, for external flight software or hardware
 on the same bus), ``report RUN_DIR`` (redraw plots, print the summary), ``export RUN_DIR``
-(decoded signals: MF4 or CSV), ``replay RUN_DIR`` (a recorded run into a new flight
+(decoded signals: MF4, CSV or Parquet), ``replay RUN_DIR`` (a recorded run into a new flight
 software, compared), ``timing RUN_DIR``
 (per-message timing, chains, bus load, worst-case bounds; ``timing --live --bus SPEC``
 measures a running bus). Exit codes: 0 pass, 1 the run's expectations failed (``timing
@@ -324,11 +324,12 @@ def build_parser() -> argparse.ArgumentParser:
     inj.add_argument("--clear", action="store_true", help="clear the fault instead")
     inj.add_argument("--print-frame", type=opt.integer("--print-frame"), metavar="COUNTER",
                      help="only print the frame for cansend, with this alive counter")
-    cp = sub.add_parser("campaign", help="a campaign file's Monte Carlo / sweep on Dask, or "
-                        "every single-thruster failure of a scenario; `campaign rerun DIR "
-                        "CASE` reruns one case, `campaign minimize DIR CASE` finds a "
-                        "failure's minimal dispersions, `campaign margin` finds a "
-                        "requirement's margin")
+    campaign_help = ("a campaign file's Monte Carlo / sweep on Dask, or every single-thruster "
+                     "failure of a scenario; `campaign rerun DIR CASE` reruns one case, "
+                     "`campaign minimize DIR CASE` finds a failure's minimal dispersions, "
+                     "`campaign margin SCENARIO --key K --toward V` finds a requirement's "
+                     "margin (each has its own --help; docs/campaigns.md)")
+    cp = sub.add_parser("campaign", help=campaign_help, description=campaign_help)
     from bench.operator.campaign import add_arguments
 
     add_arguments(cp, default_jobs=1)

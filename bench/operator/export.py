@@ -209,7 +209,7 @@ def add_parser(sub: Any) -> None:
     from dbc import options as opt
 
     ex = sub.add_parser("export", help="decode a run's CAN trace into one channel per DBC "
-                        "signal, in physical units (MF4 or CSV)")
+                        "signal, in physical units (MF4, CSV or Parquet)")
     ex.add_argument("run_dir", metavar="RUN_DIR", type=opt.text("RUN_DIR", "a run folder"),
                     help="a run folder (with its trace.asc or trace.asc.gz)")
     ex.add_argument("--format", type=opt.choice("--format", FORMATS), default="csv",

@@ -170,9 +170,10 @@ class RunTiming:
         except json.JSONDecodeError as exc:
             raise RunError(f"{summary_path}: not JSON ({exc})") from exc
         if summary.get("record") == RECORD_LEAN:
-            raise RunError(f"{d}: recorded at the lean level (a campaign's case), which keeps "
-                           "no frames.csv: timing needs a standard record (run it again "
-                           "without --record lean, or `thruster-hil campaign rerun DIR CASE`)")
+            raise ConfigError(str(d), "record", RECORD_LEAN, "a run recorded at the standard or "
+                              "full level: a lean one (a campaign's case) keeps no frames.csv "
+                              "(`thruster-hil campaign rerun CAMPAIGN_DIR CASE` makes the case's "
+                              "whole folder, frames.csv included)")
         db = load_database() if db is None else db
         bitrate = summary.get("bitrate_bps") or _dbc_bitrate_bps(db)
         frames = FrameTable.from_columns(read_csv_columns(run_file(d, "frames.csv"),

@@ -133,3 +133,20 @@ def test_a_folder_of_an_earlier_digest_format_is_not_resumed(
     err = capsys.readouterr().err
     assert code == EXIT_BAD_INPUT and "earlier version" in err, err
     assert json.loads((out / "manifest.json").read_text(encoding="utf-8")) == old
+
+
+def test_a_scheduler_that_refuses_is_bad_input_at_once_and_makes_no_folder(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--scheduler at a port nobody listens on: exit 2 naming the address, without Dask's
+    30 s of retries, and no campaign folder made."""
+    import socket
+
+    with socket.socket() as s:  # a port that was free a moment ago
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    f = _write(tmp_path, "")
+    out = tmp_path / "out"
+    code = main([str(f), "--out", str(out), "--scheduler", f"tcp://127.0.0.1:{port}"])
+    err = capsys.readouterr().err
+    assert code == EXIT_BAD_INPUT and f"127.0.0.1:{port}" in err, err
+    assert not out.exists()

@@ -77,7 +77,7 @@ def test_a_caller_that_hangs_up_has_its_run_stopped(
     request = {"argv": ["run", str(QUICKSTART), "--bus", unique_bus(), "--no-plots",
                         "--out", str(out)],
                "env": dict(os.environ, XDG_RUNTIME_DIR=str(runtime)), "cwd": str(tmp_path),
-               "stderr": str(tmp_path / "err.txt")}
+               "console": str(tmp_path / "err.txt")}
     with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as conn:
         conn.connect(str(zygote.path))
         conn.sendall(json.dumps(request).encode() + b"\n")
@@ -132,6 +132,19 @@ def test_a_zygote_closed_during_a_run_lets_the_run_complete_its_folder(
     assert len(errors) == 1 and isinstance(errors[0], RunError), errors
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     assert summary["ended"] == "SIGTERM"
+
+
+def test_sigterm_ends_the_zygote_and_it_removes_its_folder() -> None:
+    """A SIGTERM to the zygote (a campaign's process group stopped): it exits, and its
+    folder (socket, log) is gone with it."""
+    import signal
+
+    z = Zygote()
+    folder = z.path.parent
+    z._proc.send_signal(signal.SIGTERM)
+    assert z._proc.wait(GONE_WITHIN_S) == 0
+    assert not folder.exists()
+    z.close()
 
 
 def test_closing_the_zygote_ends_it_and_removes_its_folder() -> None:

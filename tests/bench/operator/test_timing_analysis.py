@@ -385,3 +385,15 @@ def test_message_sent_but_never_on_the_trace_is_all_missed(tmp_path: Path) -> No
     assert rt.unheard() == ["THR_CMD_0"] and rt.messages["IMU_RATE"].missed_cycles == 0
     assert list(rt.messages) == ["THR_CMD_0", "IMU_RATE"]  # in ID order
     assert "sent but never received: THR_CMD_0 (50 frames sent)" in format_report(rt)
+
+
+def test_a_lean_run_is_refused_naming_what_it_lacks(tmp_path: Path) -> None:
+    """A folder recorded at the lean level has no frames.csv: a ConfigError (bad input)
+    naming the level and how to get the whole folder, not a missing-file run error."""
+    from bench.operator.analysis.timing import RunTiming
+    from dbc.errors import ConfigError
+
+    (tmp_path / "summary.json").write_text(json.dumps({"record": "lean"}), encoding="utf-8")
+    with pytest.raises(ConfigError, match="lean") as err:
+        RunTiming.load(tmp_path)
+    assert "campaign rerun" in str(err.value)
