@@ -49,7 +49,7 @@ def _run(work: Path, name: str, duration_s: float, frames: int,
     bus, out = f"hilbus:hostile{uuid.uuid4().hex[:8]}", work / name
     t0 = time.monotonic()
     run = subprocess.Popen(
-        [sys.executable, "-m", "bench.operator.cli", "run", str(QUICKSTART), "--bus", bus,
+        [sys.executable, "-m", "bench.operator.entry", "run", str(QUICKSTART), "--bus", bus,
          "--duration", str(duration_s), "--seed", "7", "--out", str(out)],
         env=env, cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     sent = None

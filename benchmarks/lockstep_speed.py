@@ -13,7 +13,9 @@ change in the machine's load spreads over all of them; then the quickstart comma
   own share of a cycle (cycle p50 minus wait p50);
 - ``command``: the whole ``thruster-hil run scenarios/quickstart.toml`` as a user runs it
   (interpreter start to exit, measured here), its loop time (``wall_time_s``) and the
-  difference, the overhead, with plots and with ``--no-plots`` (medians); the parts of
+  difference, the overhead, with plots, with ``--no-plots`` and with plots but the
+  flight software's prestart off (``THRUSTER_HIL_PRESTART=0``: started cold once the
+  bench is up; ``prestart_gain_s``: the median of the paired differences); the parts of
   the overhead measured alone: the command's own start (``thruster-hil --help``: the
   interpreter and the console's imports), the flight software's start-up
   (``python -m flight_sw --check``: interpreter, imports and design-time set-up) and the
@@ -56,6 +58,13 @@ NS_PER_S = 1e9
 PACKAGES = ("bench", "dbc", "flight_sw", "transport")
 # a lockstep cycle's parts, in order (summary.json lockstep_wall_us; bench.lockstep)
 SPLIT = ("before_sync", "meanwhile", "waiting_for_fsw", "after_commands")
+CONSOLE = (sys.executable, "-m", "bench.operator.entry")  # what the console script runs
+# the command's variants, taking turns: (options, environment)
+VARIANTS: dict[str, tuple[tuple[str, ...], dict[str, str]]] = {
+    "plots": ((), {}),
+    "no_plots": (("--no-plots",), {}),
+    "plots_prestart_off": ((), {"THRUSTER_HIL_PRESTART": "0"}),
+}
 
 
 def _timed(argv: list[str], env: dict[str, str]) -> float:
@@ -71,8 +80,7 @@ def _run(scenario: Path, scratch: Path, env: dict[str, str],
     (a named bus would add the 0.25 s listen for another run); its wall time [s] and its
     summary."""
     out = scratch / f"{scenario.stem}-{uuid.uuid4().hex[:8]}"
-    wall_s = _timed([sys.executable, "-m", "bench.operator.cli", "run", str(scenario),
-                     "--out", str(out), *extra], env)
+    wall_s = _timed([*CONSOLE, "run", str(scenario), "--out", str(out), *extra], env)
     summary: dict[str, Any] = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     return wall_s, summary
 
@@ -106,13 +114,13 @@ def _scenario_figures(summaries: list[dict[str, Any]]) -> dict[str, Any]:
 
 def _command_figures(runs: int, scratch: Path, env: dict[str, str]) -> dict[str, Any]:
     """The quickstart command with and without plots (alternating), and its parts alone."""
-    rows: dict[str, list[tuple[float, float]]] = {"plots": [], "no_plots": []}
+    rows: dict[str, list[tuple[float, float]]] = {key: [] for key in VARIANTS}
     for _ in range(runs):
-        for key, extra in (("plots", ()), ("no_plots", ("--no-plots",))):
-            wall_s, s = _run(QUICKSTART, scratch, env, extra)
+        for key, (extra, env_extra) in VARIANTS.items():
+            wall_s, s = _run(QUICKSTART, scratch, env | env_extra, extra)
             rows[key].append((wall_s, s["wall_time_s"]))
     config = next(scratch.glob("quickstart-*/fsw_config.json"))
-    help_s = [_timed([sys.executable, "-m", "bench.operator.cli", "--help"], env)
+    help_s = [_timed([*CONSOLE, "--help"], env)
               for _ in range(runs)]
     fsw_s = [_timed([sys.executable, "-m", "flight_sw", "--check", "--config", str(config)],
                     env) for _ in range(runs)]
@@ -129,6 +137,9 @@ def _command_figures(runs: int, scratch: Path, env: dict[str, str]) -> dict[str,
         "fsw_start_up": _median(fsw_s),
         "plots": out["plots"]["overhead_s_median"] - out["no_plots"]["overhead_s_median"],
     }
+    out["prestart_gain_s"] = _median([off[0] - on[0] for on, off in
+                                      zip(rows["plots"], rows["plots_prestart_off"],
+                                          strict=True)])
     return out
 
 

@@ -39,7 +39,7 @@ def _run(extra: list[str], scratch: Path, bus: str | None = None) -> dict[str, A
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
     bus = bus or f"hilbus:bm{uuid.uuid4().hex[:8]}"
     subprocess.run(
-        [sys.executable, "-m", "bench.operator.cli", "run", str(QUICKSTART), "--bus", bus,
+        [sys.executable, "-m", "bench.operator.entry", "run", str(QUICKSTART), "--bus", bus,
          "--out", str(out), *extra],
         cwd=REPO, env=env, capture_output=True, check=False,
     )

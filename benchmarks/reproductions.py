@@ -135,7 +135,7 @@ def run_scenario(scenario: Path, sets: tuple[str, ...], out: Path) -> dict[str, 
     """``thruster-hil run`` in lockstep on a private portable bus; the run's summary."""
     xdg = Path(tempfile.mkdtemp(prefix="xdg-"))
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
-    cmd = [sys.executable, "-m", "bench.operator.cli", "run", str(scenario), "--out", str(out),
+    cmd = [sys.executable, "-m", "bench.operator.entry", "run", str(scenario), "--out", str(out),
            "--bus", f"hilbus:rp{uuid.uuid4().hex[:8]}"]
     for s in sets:
         cmd += ["--set", s]

@@ -142,7 +142,7 @@ def measure(scenario: Path, duration_s: float, from_s: float, every_s: float,
     scratch = Path(tempfile.mkdtemp(prefix="thil-res-"))
     out = scratch / "run"
     env = dict(os.environ, XDG_RUNTIME_DIR=str(scratch))
-    cmd = [sys.executable, "-m", "bench.operator.cli", "run", str(scenario), "--duration",
+    cmd = [sys.executable, "-m", "bench.operator.entry", "run", str(scenario), "--duration",
            str(duration_s), "--bus", f"hilbus:res{uuid.uuid4().hex[:8]}", "--out", str(out),
            *extra]
     t0 = time.monotonic()

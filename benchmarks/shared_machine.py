@@ -61,7 +61,7 @@ def _telemetry(run_dir: Path) -> str | None:
 def _start(out: Path, xdg: Path, extra: list[str], group: bool = False) -> subprocess.Popen[str]:
     env = dict(os.environ, XDG_RUNTIME_DIR=str(xdg))
     return subprocess.Popen(
-        [sys.executable, "-m", "bench.operator.cli", "run", str(QUICKSTART), "--seed", "5",
+        [sys.executable, "-m", "bench.operator.entry", "run", str(QUICKSTART), "--seed", "5",
          "--out", str(out), *extra], cwd=REPO, env=env, stdout=subprocess.PIPE,
         stderr=subprocess.PIPE, text=True, start_new_session=group)
 

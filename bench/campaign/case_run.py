@@ -24,7 +24,6 @@ a rerun is compared on.
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import json
 import os
 import shutil
@@ -37,12 +36,12 @@ from typing import Any
 
 from bench.campaign.zygote import Zygote
 from bench.operator.verdict import abnormal_events
+from bench.operator.warm_start import die_with_parent
 from bench.results.record import RECORD_STANDARD
 from dbc.errors import RunError
 from dbc.records import write_record
 
 EXIT_BAD_INPUT = 2
-PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 STOP_GRACE_S = 10.0
 """After SIGTERM, seconds a run gets to end its pair and write its folder before SIGKILL."""
 RESULT_FILE = "result.json"
@@ -75,11 +74,6 @@ def run_command(scenario: Path, case: dict[str, Any], out: Path,
     for o in case["overrides"]:
         cmd += ["--set", o]
     return cmd
-
-
-def _die_with_parent() -> None:  # pragma: no cover - runs in the child before exec
-    with contextlib.suppress(OSError, AttributeError):
-        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 def _metric(s: dict[str, Any], key: str) -> float | None:
@@ -144,9 +138,9 @@ def _stop(p: subprocess.Popen[bytes]) -> None:
 def _run_cold(argv: list[str], env: dict[str, str], console: Path, timeout_s: float) -> int:
     """``thruster-hil ARGV`` as a new interpreter; its exit code (TimeoutExpired: stopped)."""
     with open(console, "wb") as out:
-        p = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", *argv], env=env,
+        p = subprocess.Popen([sys.executable, "-m", "bench.operator.entry", *argv], env=env,
                              stdin=subprocess.DEVNULL, stdout=out, stderr=out,
-                             start_new_session=True, preexec_fn=_die_with_parent)
+                             start_new_session=True, preexec_fn=die_with_parent)
     try:
         return p.wait(timeout_s)
     except BaseException:

@@ -30,7 +30,6 @@ import contextlib
 import json
 import os
 import selectors
-import shlex
 import shutil
 import signal
 import socket
@@ -41,6 +40,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bench.operator.fsw_prestart import DEFAULT_FSW_MODULE
 from dbc.errors import RunError
 
 READY = "ready"
@@ -56,21 +56,13 @@ END_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 CLI_MODULE = "bench.operator.cli"
 
 
-def _fsw_module() -> str:
-    """The module of the default flight-software command (``python -m MODULE``)."""
-    from bench.operator.fsw_process import DEFAULT_FSW_CMD
-
-    args = shlex.split(DEFAULT_FSW_CMD)
-    return args[args.index("-m") + 1]
-
-
 def preload() -> None:
     """Import what a run's three processes import (module docstring), then freeze it."""
     import gc
     import importlib
 
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    importlib.import_module(f"{_fsw_module()}.__main__")
+    importlib.import_module(f"{DEFAULT_FSW_MODULE}.__main__")
     for name in ("bench.operator.cli", "bench.operator.orchestrator",
                  "bench.operator.bench_process", "bench.node", "bench.lockstep",
                  "bench.realtime"):
@@ -96,8 +88,7 @@ def _read_request(conn: socket.socket) -> dict[str, Any]:
 def _start(req: dict[str, Any]) -> int:
     """Fork the run of ``req``; its pid."""
     from bench.operator.cli import main
-    from bench.operator.fsw_process import die_with_parent
-    from bench.operator.warm_start import WARM_ENV, fork_program
+    from bench.operator.warm_start import WARM_ENV, die_with_parent, fork_program
 
     argv = [str(a) for a in req["argv"]]
     env = {str(k): str(v) for k, v in req["env"].items()} | {WARM_ENV: "1"}

@@ -21,9 +21,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from bench.node import BenchNode
+from bench.operator.fsw_prestart import FswPrestart
 from bench.operator.fsw_process import (
     FswProcess,
-    die_with_parent,
     fsw_argv,
     fsw_report,
     log_tail,
@@ -38,7 +38,7 @@ from bench.operator.run_warnings import (
     scenario_warnings,
 )
 from bench.operator.verdict import abnormal, verdict
-from bench.operator.warm_start import fork_program, run_module, warm_module
+from bench.operator.warm_start import die_with_parent, fork_program, run_module, warm_module
 from bench.results.counts import merge_counts, zero_unheard
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
@@ -52,25 +52,31 @@ if TYPE_CHECKING:
     from bench.operator.orchestrator import RunOptions
 
 
-def _start_fsw(opts: RunOptions, config: Path, stats: Path) -> FswProcess:
+def _start_fsw(opts: RunOptions, config: Path, stats: Path, prestart: FswPrestart | None
+               ) -> tuple[FswProcess, str]:
     """The flight-software child, its output in ``fsw.log``, its pid in ``fsw.pid``: started
-    warm (forked, bench.operator.warm_start) where this process may and can, else by its
-    command line."""
+    warm (forked, bench.operator.warm_start) where this process may and can, else in the
+    console's prestart (bench.operator.fsw_prestart) if it serves this command, else by its
+    command line. With how it started: ``forked``, ``prestart`` or ``command``
+    (summary.json ``fsw.start``)."""
     out = opts.out
     assert opts.fsw_cmd is not None
     argv = fsw_argv(opts.fsw_cmd, opts.bus, opts.mode, out, config, stats)
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     module = warm_module(argv, env)
     with open(out / "fsw.log", "wb") as log:  # the child keeps its own copy
-        proc: FswProcess
+        proc: FswProcess | None = None
+        how = "forked"
         if module is not None:
             proc = fork_program(run_module(module, argv[3:]), log.fileno(), log.fileno(),
                                 in_child=_unbuffered_fsw)
-        else:
-            proc = subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, env=env,
-                                    preexec_fn=die_with_parent)
+        elif prestart is not None:
+            proc, how = prestart.run(argv, env, os.getcwd(), str(out / "fsw.log")), "prestart"
+        if proc is None:
+            proc, how = subprocess.Popen(argv, stdout=log, stderr=subprocess.STDOUT, env=env,
+                                         preexec_fn=die_with_parent), "command"
     (out / "fsw.pid").write_text(f"{proc.pid}\n", encoding="utf-8")
-    return proc
+    return proc, how
 
 
 def _unbuffered_fsw() -> None:  # pragma: no cover - runs in the warm child
@@ -90,8 +96,12 @@ def run_bench(
     spin_s: float = 0.0,
     reserve: DiskReserve | None = None,
     alert: Callable[[int, str, dict[str, Any]], None] | None = None,
+    prestart: FswPrestart | None = None,
 ) -> dict[str, Any]:
     """The bench process: run, then write summary.json (whatever happened).
+
+    ``prestart``: the console's prestart, where the flight software starts if it serves
+    its command (bench.operator.fsw_prestart).
 
     ``spin_s``: lockstep, how long to poll for the flight software's answer before blocking
     (transport.lockstep.lockstep_spin_s; our flight software works its own out the same way).
@@ -100,9 +110,10 @@ def run_bench(
     stats = out / "fsw_stats.json"
     bus = open_bus(opts.bus, **mode_options(opts.bus, opts.mode))
     proc: FswProcess | None = None
+    fsw_start: str | None = None
     try:
         if opts.fsw_cmd is not None:  # first: it boots while the bench node is built
-            proc = _start_fsw(opts, config, stats)
+            proc, fsw_start = _start_fsw(opts, config, stats, prestart)
         node = BenchNode(sc, load_database(), bus, out, opts.mode, opts.seed, opts.bus,
                          progress, record=opts.record)
     except BaseException:
@@ -145,6 +156,8 @@ def run_bench(
     summary["ended"] = ("completed" if error is None
                         else error.name if isinstance(error, Stopped) else "error")
     summary["fsw"] = fsw_report(stats, fsw_rc, out)
+    if fsw_start is not None:
+        summary["fsw"]["start"] = fsw_start
     merge_counts(summary["frames"], summary["rejected_other"], "FSW",
                  summary["fsw"].get("sent", {}), summary["fsw"].get("received", {}))
     fsw_heard = {"FSW"} if "received" in summary["fsw"] else set()

@@ -25,6 +25,7 @@ from typing import Any
 
 from bench.operator import export, monitor, replay
 from bench.operator.console import print_summary, progress_printer
+from bench.operator.fsw_prestart import FswPrestart
 from bench.operator.junit import write_junit
 from bench.operator.lifecycle import Stopped
 from bench.results.record import RECORD_CHOICES, RECORD_STANDARD
@@ -39,7 +40,7 @@ EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report it
 MAX_SUMMARY_BYTES = 64 << 20  # a summary.json of a long run with many faults: a few MB
 
 
-def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
+def _cmd_run(args: argparse.Namespace, alone: bool, prestart: FswPrestart | None) -> int:
     from bench.operator import alerts
     from bench.operator.fsw_process import DEFAULT_FSW_CMD
     from bench.operator.orchestrator import RunOptions, run_scenario
@@ -92,13 +93,12 @@ def _cmd_run(args: argparse.Namespace, alone: bool) -> int:
         sys.stdout.flush()
         printed.append(True)
 
-    # the monitor owns a terminal while the run goes: no progress bar or alert lines under
-    # it (its event log shows them; the summary printed after it lists what was abnormal)
+    # no progress bar or alert lines under the monitor's screen: its event log shows them
     on_screen = not (opts.monitor and sys.stdout.isatty())
     try:
-        summary = run_scenario(sc, opts, progress_printer() if on_screen else None,
-                               ready if alone else None,
-                               alerts.printer() if on_screen else None, show)
+        summary = run_scenario(sc, opts, progress_printer() if on_screen else None, ready
+                               if alone else None, alerts.printer() if on_screen else None,
+                               show, prestart)
     except BaseException as exc:  # a failed or stopped run is a CI result too
         if junit is not None:
             write_junit(junit, opts.out, sc.name, f"{type(exc).__name__}: {exc}")
@@ -439,8 +439,9 @@ def _add_timing_parser(sub: Any) -> None:
     )
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``thruster-hil`` console script."""
+def main(argv: list[str] | None = None, prestart: FswPrestart | None = None) -> int:
+    """The console (bench.operator.entry starts it); ``prestart``: where a ``run`` starts
+    its flight software, if it can (bench.operator.fsw_prestart)."""
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["campaign"] and argv[1:2] in (["rerun"], ["margin"], ["minimize"]):
         from bench.campaign.tools import main as campaign_tool
@@ -450,14 +451,14 @@ def main(argv: list[str] | None = None) -> int:
     if isinstance(args, int):
         return args
     try:
-        return _dispatch(args)
+        return _dispatch(args, prestart)
     finally:
         # What was loaded (matplotlib's heap, the bench's tables) is never collected again:
         # the interpreter's last collection would walk all of it on exit (~0.1 s)
         gc.freeze()
 
 
-def _dispatch(args: argparse.Namespace) -> int:
+def _dispatch(args: argparse.Namespace, prestart: FswPrestart | None = None) -> int:
     """Run the chosen subcommand; errors become exit codes (module docstring)."""
     try:
         if args.command == "report":
@@ -476,7 +477,7 @@ def _dispatch(args: argparse.Namespace) -> int:
             from bench.operator.campaign import from_namespace
 
             return from_namespace(args)
-        return _cmd_run(args, alone=args.command == "bench")
+        return _cmd_run(args, args.command == "bench", prestart)
     except (ConfigError, BusError, IcdError) as exc:
         print(f"thruster-hil: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -12,7 +12,6 @@ write its statistics before it is killed. docs/icd.md states the rules for anoth
 
 from __future__ import annotations
 
-import ctypes
 import json
 import os
 import selectors
@@ -25,15 +24,14 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from bench.operator.analysis.reception import RX_LOG_FILE
+from bench.operator.fsw_prestart import DEFAULT_FSW_MODULE, FSW_TERM_TIMEOUT_S
 from dbc.contract import REFUSAL_SCHEMA, FswRefusal
 from dbc.errors import ConfigError
 
 DEFAULT_FSW_CMD = (
-    f"{shlex.quote(sys.executable)} -m flight_sw --bus {{bus}} --mode {{mode}} "
+    f"{shlex.quote(sys.executable)} -m {DEFAULT_FSW_MODULE} --bus {{bus}} --mode {{mode}} "
     "--config {config} --stats {stats} --rx-log {rx_log}"
 )
-FSW_TERM_TIMEOUT_S = 5.0
-PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 LOG_TAIL_LINES = 5
 
 
@@ -74,17 +72,6 @@ def fsw_argv(template: str, bus: str, mode: str, out: Path, config: Path, stats:
             parts.append(values[name])
         argv.append("".join(parts))
     return argv
-
-
-
-def die_with_parent() -> None:
-    """In the child: ask Linux for SIGTERM when the bench process dies (even by SIGKILL).
-
-    Elsewhere (macOS) this is a no-op; the flight software then notices the silence itself.
-    """
-    if sys.platform.startswith("linux"):
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 

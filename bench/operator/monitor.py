@@ -184,22 +184,23 @@ def process_ended(pid: int) -> Callable[[], bool]:
     return ended
 
 
-def watch_run(bus_spec: str, pid: int, before_app: Callable[[], None] | None = None,
+def watch_run(bus: RelayBus, pid: int, before_app: Callable[[], None] | None = None,
               refresh_s: float = DEFAULT_REFRESH_S, db: Database | None = None) -> None:
     """``thruster-hil run --monitor``: the monitor on a run's bus until the run's process
-    ``pid`` ends (or q: the run goes on). ``before_app`` runs once the bus is being read
-    (the supervisor's own preparations). Without a terminal it prints the last picture."""
+    ``pid`` ends (or q: the run goes on), then ``bus`` shut down. ``bus`` is on the run's
+    bus before its bench starts (a relay already joined sees the run's first frame).
+    ``before_app`` runs once the bus is being read (the supervisor's own preparations).
+    Without a terminal it prints the last picture."""
     import sys
 
     from dbc.database import load_database
 
-    bus = RelayBus(spec=bus_spec)
     reader = BusReader(bus, MonitorState(db or load_database()))
     reader.start()
     try:
         if before_app is not None:
             before_app()
-        app = make_app(reader, f"thruster-hil run --monitor {bus_spec}", refresh_s, None,
+        app = make_app(reader, f"thruster-hil run --monitor {bus.spec}", refresh_s, None,
                        process_ended(pid))
         app.run(headless=not sys.stdout.isatty())
         if not sys.stdout.isatty():

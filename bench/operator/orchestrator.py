@@ -28,7 +28,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from bench.operator.fsw_process import DEFAULT_FSW_CMD, die_with_parent, fsw_argv
+from bench.operator.fsw_prestart import FswPrestart
+from bench.operator.fsw_process import DEFAULT_FSW_CMD, fsw_argv
 from bench.operator.lifecycle import (
     DiskReserve,
     Stopped,
@@ -39,6 +40,7 @@ from bench.operator.lifecycle import (
 from bench.operator.partial import partial_summary, plot_folder, preload_plots
 from bench.operator.shared_bus import probe
 from bench.operator.verdict import abnormal, verdict
+from bench.operator.warm_start import die_with_parent
 from bench.results.record import RECORD_STANDARD, check_record
 from bench.results.writers import write_summary
 from bench.scenario.spec import Scenario
@@ -47,6 +49,7 @@ from dbc.database import load_database
 from dbc.errors import ConfigError, RefusedConfigError, RunError
 from dbc.records import write_record
 from transport.lockstep import available_cpus, lockstep_spin_s
+from transport.relay import RelayBus
 from transport.spec import open_bus
 
 EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH, EXIT_CHILD_BAD_INPUT = 0, 3, 4, 5
@@ -86,8 +89,12 @@ def run_scenario(
     ready: Callable[[Path], None] | None = None,
     alert: Callable[[int, str, dict[str, Any]], None] | None = None,
     summary_ready: Callable[[dict[str, Any]], None] | None = None,
+    prestart: FswPrestart | None = None,
 ) -> dict[str, Any]:
     """Run ``sc``; returns the summary (also written to ``opts.out/summary.json``).
+
+    ``prestart``: where the bench starts the flight software if it can
+    (bench.operator.fsw_prestart); this process lets go of it once the bench is forked.
 
     ``alert`` hears every event of the run as it happens (bench.operator.alerts);
     ``summary_ready`` gets the summary of a run that completed as soon as it is written,
@@ -111,12 +118,16 @@ def run_scenario(
             _write_refusal(sc, opts, refusal, heard)
             raise refusal
     spin_s = lockstep_spin_s(available_cpus(), os.environ) if opts.mode == "lockstep" else 0.0
+    # the monitor's relay joins the bus before the bench starts: it sees the first frame
+    watcher = RelayBus(spec=opts.bus) if opts.monitor else None
     try:
         out.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(sc.path, out / "scenario.toml")
         config = out / "fsw_config.json"
         write_record(config, sc.fsw_config())
     except OSError as exc:
+        if watcher is not None:
+            watcher.shutdown()
         raise ConfigError("command line", "--out", str(out),
                           f"a folder this user can create and write ({exc.strerror or exc})"
                           ) from exc
@@ -125,7 +136,8 @@ def run_scenario(
         from bench.operator.bench_process import run_bench
 
         try:
-            return run_bench(sc, opts, progress, ready, config, spin_s, reserve, alert)
+            return run_bench(sc, opts, progress, ready, config, spin_s, reserve, alert,
+                             prestart)
         finally:
             _plots(opts, sc)
     pid = os.fork()
@@ -139,7 +151,7 @@ def run_scenario(
             # and the flight software starts before they load (bench.operator.bench_process)
             from bench.operator.bench_process import run_bench
 
-            run_bench(sc, opts, progress, ready, config, spin_s, reserve, alert)
+            run_bench(sc, opts, progress, ready, config, spin_s, reserve, alert, prestart)
         except ConfigError as exc:
             code = EXIT_CHILD_BAD_INPUT
             if not (out / "summary.json").exists():  # refused before the run: say why
@@ -157,14 +169,17 @@ def run_scenario(
             sys.stdout.flush()
             sys.stderr.flush()
             os._exit(code)
+    if prestart is not None:  # the bench holds it now: it ends with the bench
+        prestart.release()
     # matplotlib loads while the flight software boots and the run goes (on the core the
     # bench leaves idle while it waits); the plots are drawn here once the bench is done
     prepare = preload_plots if opts.plots else None
-    if opts.monitor:
+    if watcher is not None:
         from bench.operator.monitor import watch_run
 
         def meanwhile() -> None:
-            watch_run(opts.bus, pid, prepare)
+            assert watcher is not None
+            watch_run(watcher, pid, prepare)
 
         status, stop_signal = supervise(pid, meanwhile)
     else:

@@ -34,7 +34,8 @@ from typing import Any
 import can
 from cantools.database.can import Database
 
-from bench.operator.fsw_process import DEFAULT_FSW_CMD, die_with_parent, fsw_argv, stop
+from bench.operator.fsw_process import DEFAULT_FSW_CMD, fsw_argv, stop
+from bench.operator.warm_start import die_with_parent
 from bench.results.record import trace_file
 from dbc.errors import ConfigError
 from dbc.icd import FSW, Icd

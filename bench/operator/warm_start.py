@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import ctypes
 import gc
 import io
 import os
@@ -45,6 +46,7 @@ WARM_ENV = "THRUSTER_HIL_WARM_START"
 (:func:`warm_module`); set by the campaign's zygote in the runs it starts."""
 EXIT_UNCAUGHT = 1  # what the interpreter exits with after an uncaught exception
 FD_DIR = Path("/proc/self/fd")
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 STDIO_FDS = (0, 1, 2)
 
 
@@ -59,6 +61,16 @@ def warm_module(argv: list[str], env: dict[str, str] | os._Environ[str]) -> str 
         return None
     module = argv[2]
     return module if f"{module}.__main__" in sys.modules else None
+
+
+def die_with_parent() -> None:
+    """In the child: ask Linux for SIGTERM when its parent process dies (even by SIGKILL).
+
+    Elsewhere (macOS) this is a no-op; the flight software then notices the silence itself.
+    """
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 def _open_fds() -> list[int]:

@@ -35,11 +35,11 @@ def test_lockstep_speed_reports_the_factor_the_cycle_split_and_the_command() -> 
     assert all(v > 0.0 for v in q["split_us_p50"].values())
     assert r["bytecode"] == "cached"
     c = r["command"]
-    for key in ("plots", "no_plots"):
+    for key in ("plots", "no_plots", "plots_prestart_off"):
         assert c[key]["command_s_median"] > c[key]["loop_s_median"] > 0.0, key
     parts = c["parts_alone_s"]
     assert parts["command_start"] > 0.0 and parts["fsw_start_up"] > 0.0
-    assert math.isfinite(parts["plots"])
+    assert math.isfinite(parts["plots"]) and math.isfinite(c["prestart_gain_s"])
 
 
 def test_unknown_scenario_is_refused_by_name() -> None:

@@ -55,7 +55,7 @@ def run_cli(args: list[str], out: Path, runtime_dir: Path, timeout_s: float = RU
     """Run ``thruster-hil ARGS --out OUT`` with a private hilbus runtime directory."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
     p = subprocess.run(
-        [sys.executable, "-m", "bench.operator.cli", *args, "--out", str(out)],
+        [sys.executable, "-m", "bench.operator.entry", *args, "--out", str(out)],
         capture_output=True,
         text=True,
         timeout=timeout_s,
@@ -100,7 +100,7 @@ def running(
     non-interactive shell, such as a CI runner's, inherits it ignored)."""
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
     p = subprocess.Popen(
-        [sys.executable, "-m", "bench.operator.cli", *args, "--out", str(out)],
+        [sys.executable, "-m", "bench.operator.entry", *args, "--out", str(out)],
         cwd=REPO,
         env=env,
         stdout=subprocess.DEVNULL,

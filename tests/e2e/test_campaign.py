@@ -29,7 +29,7 @@ def test_every_single_thruster_failure_is_detected_isolated_and_survived(tmp_pat
         [
             sys.executable,
             "-m",
-            "bench.operator.cli",
+            "bench.operator.entry",
             "campaign",
             str(SCENARIO),
             "--out",

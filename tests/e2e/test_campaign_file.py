@@ -32,7 +32,7 @@ def _hil(args: list[str], runtime: Path) -> subprocess.CompletedProcess[str]:
     import os
 
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime))
-    return subprocess.run([sys.executable, "-m", "bench.operator.cli", *args], env=env,
+    return subprocess.run([sys.executable, "-m", "bench.operator.entry", *args], env=env,
                           capture_output=True, text=True, timeout=RUN_TIMEOUT_S, check=False)
 
 
@@ -123,7 +123,7 @@ def test_an_interrupted_campaign_resumes(tmp_path: Path, runtime: Path) -> None:
         '[[dispersions]]\nname = "latency"\ndist = "uniform"\nlow = 0.0005\nhigh = 0.003\n')
     out = tmp_path / "out"
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime))
-    p = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", "campaign", str(f),
+    p = subprocess.Popen([sys.executable, "-m", "bench.operator.entry", "campaign", str(f),
                           "--out", str(out)], env=env, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True, start_new_session=True)
     deadline = time.monotonic() + RUN_TIMEOUT_S

@@ -82,7 +82,7 @@ def test_bench_alone_pairs_with_flight_software_started_by_hand(
         [
             sys.executable,
             "-m",
-            "bench.operator.cli",
+            "bench.operator.entry",
             "bench",
             str(QUICKSTART),
             "--bus",

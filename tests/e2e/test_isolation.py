@@ -25,7 +25,7 @@ START_PERCENT = 5.0
 def _start(out: Path, runtime_dir: Path, extra: list[str]) -> subprocess.Popen[str]:
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
     return subprocess.Popen(
-        [sys.executable, "-m", "bench.operator.cli", "run", str(QUICKSTART), "--duration",
+        [sys.executable, "-m", "bench.operator.entry", "run", str(QUICKSTART), "--duration",
          DURATION, "--seed", "3", "--out", str(out), *extra],
         cwd=REPO, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 

@@ -35,7 +35,7 @@ def test_failing_run_has_one_failure_per_failed_expectation(tmp_path: Path,
     assert any("GNC-ATT-012" in f.message for f in failures)
     assert "  FAIL settling_time_s [GNC-ATT-012] = " in run.stdout
     again = tmp_path / "again.xml"
-    done = subprocess.run([sys.executable, "-m", "bench.operator.cli", "report", str(run.out),
+    done = subprocess.run([sys.executable, "-m", "bench.operator.entry", "report", str(run.out),
                            "--junit", str(again)], capture_output=True, text=True,
                           check=False)
     assert done.returncode == EXIT_FAILED, done.stderr

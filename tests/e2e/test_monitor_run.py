@@ -32,7 +32,7 @@ def test_monitor_counts_a_played_trace_as_the_run_summary(tmp_path: Path,
     bus = unique_bus()
     channel = bus.split(":", 1)[1]
     env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
-    mon = subprocess.Popen([sys.executable, "-m", "bench.operator.cli", "monitor", "--bus", bus,
+    mon = subprocess.Popen([sys.executable, "-m", "bench.operator.entry", "monitor", "--bus", bus,
                             "--duration", MONITOR_S], cwd=REPO, env=env, text=True,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:

@@ -63,7 +63,7 @@ def _timing(args: list[str], runtime_dir: Path | None = None) -> subprocess.Comp
     if runtime_dir is not None:
         env["XDG_RUNTIME_DIR"] = str(runtime_dir)
     return subprocess.run(
-        [sys.executable, "-m", "bench.operator.cli", "timing", *args],
+        [sys.executable, "-m", "bench.operator.entry", "timing", *args],
         capture_output=True,
         text=True,
         timeout=PYTEST_TIMEOUT_S,
@@ -156,7 +156,7 @@ def _live_against_realtime_run(bus: str, tmp_path: Path, runtime_dir: Path) -> d
         [
             sys.executable,
             "-m",
-            "bench.operator.cli",
+            "bench.operator.entry",
             "timing",
             "--live",
             "--bus",

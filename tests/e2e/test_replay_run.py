@@ -20,7 +20,7 @@ TIMEOUT_S = 300.0  # a hang guard
 
 
 def _replay(run_dir: Path, *extra: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "bench.operator.cli", "replay", str(run_dir),
+    return subprocess.run([sys.executable, "-m", "bench.operator.entry", "replay", str(run_dir),
                            *extra], cwd=REPO, capture_output=True, text=True,
                           timeout=TIMEOUT_S, check=False)
 

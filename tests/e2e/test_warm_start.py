@@ -1,5 +1,6 @@
 """Warm starts, end to end: a run the campaign's zygote forks (supervisor, bench and flight
-software all forked from imported modules) is the cold command's run, byte for byte."""
+software all forked from imported modules), and a command whose flight software starts in
+its prestart (bench.operator.fsw_prestart), are the cold command's run, byte for byte."""
 
 from __future__ import annotations
 
@@ -7,13 +8,17 @@ import contextlib
 import hashlib
 import json
 import os
+import subprocess
+import sys
 import threading
 import time
+import uuid
 from pathlib import Path
 
 import pytest
 
 from bench.campaign.zygote import Zygote
+from bench.operator.fsw_prestart import PRESTART_ENV
 from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
 from tests.run_files import run_text
 
@@ -69,3 +74,49 @@ def test_a_warm_run_equals_the_cold_command(tmp_path: Path, runtime_dir: Path) -
         k: v for k, v in s_cold.items() if k not in WALL_CLOCK_KEYS}
     for s in (s_warm, s_cold):
         assert s["fsw"]["exit_code"] == 0 and s["fsw"]["sent"], s["fsw"]
+    assert (s_warm["fsw"]["start"], s_cold["fsw"]["start"]) == ("forked", "prestart")
+
+
+def test_a_prestarted_run_equals_the_cold_command(tmp_path: Path, runtime_dir: Path,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """The console script's run with its flight software in the prestart, and with the
+    prestart turned off (THRUSTER_HIL_PRESTART=0): the same exit code, trace, telemetry
+    and summary figures; summary.json says how each flight software started."""
+    args = ["run", str(QUICKSTART), "--duration", DURATION_S, "--no-plots", "--seed", "3"]
+    pre = run_cli([*args, "--bus", unique_bus()], tmp_path / "pre", runtime_dir)
+    monkeypatch.setenv(PRESTART_ENV, "0")
+    cold = run_cli([*args, "--bus", unique_bus()], tmp_path / "cold", runtime_dir)
+    assert pre.returncode == cold.returncode and pre.returncode in VERDICT_EXITS, pre.stderr
+    assert _digest(pre.out / "trace.blf") == _digest(cold.out / "trace.blf")
+    for name in ("telemetry.csv", "frames.csv", "valve_pulses.csv"):
+        assert run_text(pre.out, name) == run_text(cold.out, name), name
+    assert {k: v for k, v in pre.summary.items() if k not in WALL_CLOCK_KEYS} == {
+        k: v for k, v in cold.summary.items() if k not in WALL_CLOCK_KEYS}
+    assert (pre.summary["fsw"]["start"], cold.summary["fsw"]["start"]) == ("prestart",
+                                                                           "command")
+    for s in (pre.summary, cold.summary):
+        assert s["fsw"]["exit_code"] == 0 and s["fsw"]["sent"], s["fsw"]
+
+
+def _processes_with(mark: bytes) -> list[int]:
+    """Pids of the processes whose environment holds ``mark``."""
+    found = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            with contextlib.suppress(OSError):
+                if mark in (d / "environ").read_bytes():
+                    found.append(int(d.name))
+    return found
+
+
+def test_a_refused_run_leaves_no_prestart_behind(tmp_path: Path, runtime_dir: Path) -> None:
+    """A run refused before its bench (a bad --duration) exits 2 at once: its prestart,
+    maybe still importing, ended with it (no process of the command is left)."""
+    mark = f"THIL_TEST_MARK_{uuid.uuid4().hex}"
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir), THIL_TEST_MARK=mark)
+    done = subprocess.run([sys.executable, "-m", "bench.operator.entry", "run",
+                           str(QUICKSTART), "--duration", "-1", "--bus", unique_bus(),
+                           "--out", str(tmp_path / "out")], env=env, capture_output=True,
+                          text=True, timeout=TIMEOUT_S)
+    assert done.returncode == 2 and "--duration" in done.stderr, done.stderr
+    assert _processes_with(mark.encode()) == []

@@ -1,0 +1,47 @@
+"""The ``thruster-hil`` console script: the flight software's prestart first, then the console.
+
+A ``run`` with the default flight software (no ``--fsw-cmd``) starts its prestart
+(bench.operator.fsw_prestart) before anything else is imported, so that the flight
+software's imports run on the other core while the console imports and parses the
+scenario; then the console (bench.operator.cli) runs with it. This module imports the
+standard library only until then. Any other command goes straight to the console.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from bench.operator.fsw_prestart import DEFAULT_FSW_MODULE, FswPrestart
+
+HELP_OPTIONS = ("-h", "--help")
+
+
+def wants_prestart(argv: list[str]) -> bool:
+    """Whether the command line ``argv`` runs the default flight software: ``run`` without
+    ``--fsw-cmd`` (nor help). A wrong guess costs only the prestart's imports: a run whose
+    flight-software command is not its own starts that command."""
+    return (argv[:1] == ["run"] and FswPrestart.wanted()
+            and not any(a == "--fsw-cmd" or a.startswith("--fsw-cmd=") or a in HELP_OPTIONS
+                        for a in argv[1:]))
+
+
+def main() -> int:
+    """Entry point of the ``thruster-hil`` console script."""
+    argv = sys.argv[1:]
+    prestart: FswPrestart | None = None
+    if wants_prestart(argv):
+        try:
+            prestart = FswPrestart(DEFAULT_FSW_MODULE)
+        except OSError:  # no process to spare: the flight software starts cold
+            prestart = None
+    try:
+        from bench.operator.cli import main as cli_main
+
+        return cli_main(argv, prestart)
+    finally:
+        if prestart is not None:
+            prestart.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
