@@ -41,6 +41,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.operator.fsw_prestart import DEFAULT_FSW_MODULE
+from bench.operator.warm_start import parse_request
 from dbc.errors import RunError
 
 READY = "ready"
@@ -79,10 +80,7 @@ def _read_request(conn: socket.socket) -> dict[str, Any]:
         if not chunk or len(buf) > MAX_REQUEST_BYTES:
             raise ValueError("no complete request line")
         buf += chunk
-    req = json.loads(buf)
-    if not isinstance(req, dict) or any(k not in req for k in REQUEST_KEYS):
-        raise ValueError(f"a request has {', '.join(REQUEST_KEYS)}")
-    return req
+    return parse_request(buf, REQUEST_KEYS)
 
 
 def _start(req: dict[str, Any]) -> int:

@@ -3,7 +3,8 @@
 Forked by the supervisor (bench.operator.orchestrator), which imports this module only
 after the fork: the flight software is started first, so its start-up (interpreter,
 imports, design-time set-up: ~0.3 s) overlaps the bench's own (the bench node and its
-imports), and the bus is open before its first heartbeat. Writes ``summary.json``
+imports), and the bus is open before its first heartbeat; with the console script's
+prestart (bench.operator.fsw_prestart) its imports are done by then. Writes ``summary.json``
 (whatever happened: the flight software dying, a stop signal, an error); the supervisor
 draws the plots afterwards (bench.operator.partial.plot_folder).
 """

@@ -49,7 +49,13 @@ import subprocess
 import sys
 from typing import IO, Any
 
-from bench.operator.warm_start import WARM_ENV, die_with_parent, fork_program, run_module
+from bench.operator.warm_start import (
+    WARM_ENV,
+    die_with_parent,
+    fork_program,
+    parse_request,
+    run_module,
+)
 
 DEFAULT_FSW_MODULE = "flight_sw"
 """The module of the default flight-software command (``python -m flight_sw``)."""
@@ -235,10 +241,7 @@ def _read_request() -> dict[str, Any] | None:
         if not chunk:
             return None
         buf += chunk
-    req = json.loads(buf)
-    if not isinstance(req, dict) or any(k not in req for k in REQUEST_KEYS):
-        raise ValueError(f"a request has {', '.join(REQUEST_KEYS)}")
-    return req
+    return parse_request(buf, REQUEST_KEYS)
 
 
 def _send(record: dict[str, Any]) -> None:

@@ -1,5 +1,6 @@
 """Runs one scenario: this process supervises, the bench runs in a forked child, the
-flight software is the bench's child process.
+flight software is the bench's child process (or, with the console script's prestart,
+the prestart's: bench.operator.fsw_prestart; the bench holds it the same way).
 
 The flight software is started by command (``--fsw-cmd``, ours by default), exactly as a
 real bench starts someone else's flight-software binary, so the bench never imports it.

@@ -30,6 +30,7 @@ import contextlib
 import ctypes
 import gc
 import io
+import json
 import os
 import runpy
 import select
@@ -39,7 +40,7 @@ import sys
 import traceback
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn
 
 WARM_ENV = "THRUSTER_HIL_WARM_START"
 """``1``: a bench process starts its flight-software command warm where it can
@@ -71,6 +72,15 @@ def die_with_parent() -> None:
     if sys.platform.startswith("linux"):
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+def parse_request(line: bytes, keys: tuple[str, ...]) -> dict[str, Any]:
+    """A warm starter's request (bench.campaign.zygote, bench.operator.fsw_prestart): one
+    JSON object holding ``keys`` (ValueError otherwise)."""
+    req = json.loads(line)
+    if not isinstance(req, dict) or any(k not in req for k in keys):
+        raise ValueError(f"a request has {', '.join(keys)}")
+    return req
 
 
 def _open_fds() -> list[int]:
