@@ -132,6 +132,7 @@ def make_app(reader: BusReader, title: str, refresh_s: float,
     """The textual application over ``reader`` (imported here: only the monitor needs it);
     it ends after ``duration_s``, on q, or at the first redraw where ``stop_when()``."""
     from textual.app import App, ComposeResult
+    from textual.css.query import NoMatches
     from textual.widgets import DataTable, Footer, Header, Log, Static
 
     class MonitorApp(App[None]):
@@ -155,10 +156,14 @@ def make_app(reader: BusReader, title: str, refresh_s: float,
                 self.set_timer(duration_s, self.exit)
 
         def redraw(self) -> None:
+            try:
+                vehicle = self.query_one("#vehicle", Static)
+            except NoMatches:  # a last timer tick while the app closes: its screen is gone
+                return
             done = stop_when is not None and stop_when()
             s = reader.snapshot()
             self.picture = s
-            self.query_one("#vehicle", Static).update(vehicle_text(s))
+            vehicle.update(vehicle_text(s))
             self.query_one("#thrusters", Static).update(thruster_text(s))
             table = self.query_one("#messages", DataTable)
             table.clear()
