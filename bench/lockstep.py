@@ -60,28 +60,31 @@ class Lockstep:
         clock, wire, results = n.clock, n.wire, n.results
         results.lockstep_spin_s = n.lockstep_spin_s
         wall0 = clock.now_ns()
-        n._start()
-        for k in range(n_cycles):
-            t_k = k * period
-            cycle_wall0 = clock.now_ns()
-            n._emit_samples(t_k)
-            # SYNC closes the samples of (t_{k-1}, t_k]: it is queued once they are through,
-            # and the flight software's cycle starts when SYNC has arrived.
-            wire.flush()
-            n._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S}, max(t_k, wire.last_rx_ns))
+        try:  # the loop's wall time, also of a run a signal stops
+            n._start()
+            for k in range(n_cycles):
+                t_k = k * period
+                cycle_wall0 = clock.now_ns()
+                n._emit_samples(t_k)
+                # SYNC closes the samples of (t_{k-1}, t_k]: it is queued once they are through,
+                # and the flight software's cycle starts when SYNC has arrived.
+                wire.flush()
+                n._send("SYNC", {"Cycle": k, "SimTime": t_k / NS_PER_S},
+                        max(t_k, wire.last_rx_ns))
+                wire.release()
+                wire.flush()
+                self.synced_ns = clock.now_ns()
+                self._collect(k, wire.last_rx_ns + delay_ns, duration_s)
+                n.integrate_to(t_k + period)
+                cycle_wall1 = clock.now_ns()
+                results.cycle_wall_ns.add(cycle_wall1 - cycle_wall0)
+                results.before_sync_ns.add(self.synced_ns - cycle_wall0)
+                results.after_commands_ns.add(cycle_wall1 - self.answered_ns)
             wire.release()
             wire.flush()
-            self.synced_ns = clock.now_ns()
-            self._collect(k, wire.last_rx_ns + delay_ns, duration_s)
-            n.integrate_to(t_k + period)
-            cycle_wall1 = clock.now_ns()
-            results.cycle_wall_ns.add(cycle_wall1 - cycle_wall0)
-            results.before_sync_ns.add(self.synced_ns - cycle_wall0)
-            results.after_commands_ns.add(cycle_wall1 - self.answered_ns)
-        wire.release()
-        wire.flush()
-        n._samples.clear()
-        results.wall_s = (clock.now_ns() - wall0) / NS_PER_S
+            n._samples.clear()
+        finally:
+            results.wall_s = (clock.now_ns() - wall0) / NS_PER_S
         n.trace.event(n.station.t_ns, "run_finished", stalls=results.stalls)
 
     def _collect(self, k: int, ready_ns: int, duration_s: float) -> None:

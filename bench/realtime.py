@@ -61,29 +61,31 @@ class Realtime:
         n._start()
         n._emit_samples(0)
         next_progress = next_flush = 0
-        while st.t_ns < end_ns:
-            results.note_lag(clock.now_ns() - st.t_ns, n.period_ns)
-            n.integrate_to(min(clock.now_ns(), end_ns) // STEP_NS * STEP_NS)
-            wait_s = max(0.0, (st.t_ns + STEP_NS - clock.now_ns()) / NS_PER_S)
-            msg = n.bus.recv(timeout=wait_s)
-            n_read = 0
-            while msg is not None:
-                self.frame(msg)
-                n_read += 1
-                if n_read >= RT_FRAMES_PER_PASS or st.t_ns >= end_ns:
-                    break  # back to stepping; the rest stays queued for the next pass
-                msg = n.bus.recv(timeout=0.0)
-            if st.t_ns >= next_flush:
-                n.trace.flush()
-                results.flush()
-                next_flush += FLUSH_PERIOD_NS
-            if st.t_ns >= next_progress:
-                n.check_fsw_alive()
-                if n.progress is not None:
-                    n.progress(st.t_ns / NS_PER_S, duration_s)
-                next_progress += PROGRESS_EVERY_CYCLES * n.period_ns
+        try:  # the run's wall time, also of a run a signal stops
+            while st.t_ns < end_ns:
+                results.note_lag(clock.now_ns() - st.t_ns, n.period_ns)
+                n.integrate_to(min(clock.now_ns(), end_ns) // STEP_NS * STEP_NS)
+                wait_s = max(0.0, (st.t_ns + STEP_NS - clock.now_ns()) / NS_PER_S)
+                msg = n.bus.recv(timeout=wait_s)
+                n_read = 0
+                while msg is not None:
+                    self.frame(msg)
+                    n_read += 1
+                    if n_read >= RT_FRAMES_PER_PASS or st.t_ns >= end_ns:
+                        break  # back to stepping; the rest stays queued for the next pass
+                    msg = n.bus.recv(timeout=0.0)
+                if st.t_ns >= next_flush:
+                    n.trace.flush()
+                    results.flush()
+                    next_flush += FLUSH_PERIOD_NS
+                if st.t_ns >= next_progress:
+                    n.check_fsw_alive()
+                    if n.progress is not None:
+                        n.progress(st.t_ns / NS_PER_S, duration_s)
+                    next_progress += PROGRESS_EVERY_CYCLES * n.period_ns
+        finally:
+            results.wall_s = clock.now_ns() / NS_PER_S
         n._realtime_clock = None
-        results.wall_s = clock.now_ns() / NS_PER_S
         n.trace.event(st.t_ns, "run_finished", late_steps=results.late_steps,
                       max_lag_ms=results.max_lag_ns / NS_PER_MS)
 

@@ -194,7 +194,7 @@ def run_bench(
             float(getattr(bus, "member_stall_s", None) or MEMBER_STALL_S)))
     if summary["compromised"] is not None:
         summary["passed"] = False
-    if error is not None:
+    if error is not None and not isinstance(error, Stopped):  # a stop is no error: `ended`
         summary["error"] = f"{type(error).__name__}: {error}"
         if "first frame" in str(error):
             summary["fsw"]["log_tail"] = log_tail(out / "fsw.log")
@@ -203,6 +203,7 @@ def run_bench(
                 summary["error"] = f"the flight software refused its configuration: " \
                                    f"{summary['fsw']['refused']}"
                 error = RefusedConfigError("the flight software", summary["fsw"]["refused"])
+    if error is not None:
         summary["passed"] = False
     summary["verdict"], summary["abnormal"] = verdict(summary), abnormal(summary)
     write_summary(out / "summary.json", summary)

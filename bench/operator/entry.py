@@ -9,11 +9,21 @@ standard library only until then. Any other command goes straight to the console
 
 from __future__ import annotations
 
+import signal
 import sys
 
 from bench.operator.fsw_prestart import DEFAULT_FSW_MODULE, FswPrestart
 
 HELP_OPTIONS = ("-h", "--help")
+FSW_CMD_OPTION = "--fsw-cmd"
+MIN_ABBREVIATION = len("--f")  # argparse takes any unambiguous prefix of an option
+EXIT_INTERRUPTED = 128 + signal.SIGINT  # as the console reports Ctrl-C
+
+
+def _names_fsw_cmd(arg: str) -> bool:
+    """``--fsw-cmd``, ``--fsw-cmd=...`` or an abbreviation argparse takes for it."""
+    name = arg.split("=", 1)[0]
+    return len(name) >= MIN_ABBREVIATION and FSW_CMD_OPTION.startswith(name)
 
 
 def wants_prestart(argv: list[str]) -> bool:
@@ -21,8 +31,7 @@ def wants_prestart(argv: list[str]) -> bool:
     ``--fsw-cmd`` (nor help). A wrong guess costs only the prestart's imports: a run whose
     flight-software command is not its own starts that command."""
     return (argv[:1] == ["run"] and FswPrestart.wanted()
-            and not any(a == "--fsw-cmd" or a.startswith("--fsw-cmd=") or a in HELP_OPTIONS
-                        for a in argv[1:]))
+            and not any(_names_fsw_cmd(a) or a in HELP_OPTIONS for a in argv[1:]))
 
 
 def main() -> int:
@@ -38,6 +47,9 @@ def main() -> int:
         from bench.operator.cli import main as cli_main
 
         return cli_main(argv, prestart)
+    except KeyboardInterrupt:  # Ctrl-C before the console handles it (its imports)
+        print("\nthruster-hil: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     finally:
         if prestart is not None:
             prestart.close()

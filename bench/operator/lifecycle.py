@@ -70,10 +70,12 @@ def stop_on_signals() -> None:
         signal.signal(s, handler)
 
 
-def supervise(pid: int, meanwhile: Callable[[], None] | None = None) -> tuple[int, int | None]:
+def supervise(pid: int, meanwhile: Callable[[], None] | None = None,
+              pending: list[int] | None = None) -> tuple[int, int | None]:
     """In the supervisor: wait for child ``pid``, forwarding stop signals to it.
 
-    ``meanwhile`` runs first, with the signals already forwarded (the supervisor's own
+    ``pending``: stop signals held while the child was being started (forwarded first).
+    ``meanwhile`` runs then, with the signals already forwarded (the supervisor's own
     work while the bench runs: loading the plotting library). Returns the child's wait
     status and the first stop signal received (None if none).
     """
@@ -86,6 +88,8 @@ def supervise(pid: int, meanwhile: Callable[[], None] | None = None) -> tuple[in
             os.kill(pid, signum)
 
     previous = {s: signal.signal(s, forward) for s in STOP_SIGNALS}
+    for s in pending or []:
+        forward(s, None)
     try:
         if meanwhile is not None:
             meanwhile()

@@ -104,21 +104,44 @@ def run_scenario(
     The bench runs in a forked child process and this process supervises it, so that the
     run folder is completed (from the files written so far) even if the bench is killed.
     """
+    # from here (the run folder exists) until the bench is forked a stop signal waits: the
+    # folder is then completed, with the bench or without it
+    with held_stop_signals() as early:
+        out = opts.out
+        if opts.fsw_cmd is not None:
+            # a bad placeholder: exit 2 before anything runs
+            fsw_argv(opts.fsw_cmd, opts.bus, opts.mode, out, out, out)
+        check_bus(opts.bus)
+        if opts.bus_shared:
+            heard = probe(opts.bus)
+            if heard:
+                refusal = ConfigError("command line", "--bus", opts.bus,
+                                      f"a bus no other run uses (heard {', '.join(heard)} from a "
+                                      "running bench or flight software; leave out --bus for a "
+                                      "channel of this run's own)")
+                _write_refusal(sc, opts, refusal, heard)
+                raise refusal
+        spin_s = (lockstep_spin_s(available_cpus(), os.environ) if opts.mode == "lockstep"
+                  else 0.0)
+        return _fork_and_supervise(sc, opts, progress, ready, alert, summary_ready, prestart,
+                                   spin_s, early)
+
+
+def _fork_and_supervise(
+    sc: Scenario,
+    opts: RunOptions,
+    progress: Callable[[float, float], None] | None,
+    ready: Callable[[Path], None] | None,
+    alert: Callable[[int, str, dict[str, Any]], None] | None,
+    summary_ready: Callable[[dict[str, Any]], None] | None,
+    prestart: FswPrestart | None,
+    spin_s: float,
+    early: list[int],
+) -> dict[str, Any]:
+    """:func:`run_scenario` from the run folder's files on: fork the bench and supervise
+    it; ``early``: the stop signals held so far (the list goes on filling until the bench
+    is supervised, which forwards them)."""
     out = opts.out
-    if opts.fsw_cmd is not None:
-        # a bad placeholder: exit 2 before anything runs
-        fsw_argv(opts.fsw_cmd, opts.bus, opts.mode, out, out, out)
-    check_bus(opts.bus)
-    if opts.bus_shared:
-        heard = probe(opts.bus)
-        if heard:
-            refusal = ConfigError("command line", "--bus", opts.bus,
-                                  f"a bus no other run uses (heard {', '.join(heard)} from a "
-                                  "running bench or flight software; leave out --bus for a "
-                                  "channel of this run's own)")
-            _write_refusal(sc, opts, refusal, heard)
-            raise refusal
-    spin_s = lockstep_spin_s(available_cpus(), os.environ) if opts.mode == "lockstep" else 0.0
     # the monitor's relay joins the bus before the bench starts: it sees the first frame
     watcher = RelayBus(spec=opts.bus) if opts.monitor else None
     try:
@@ -133,6 +156,13 @@ def run_scenario(
                           f"a folder this user can create and write ({exc.strerror or exc})"
                           ) from exc
     reserve = DiskReserve(out)
+    if early:  # stopped before the bench: the folder says so
+        if watcher is not None:
+            watcher.shutdown()
+        name = signal.Signals(early[0]).name
+        reserve.release()
+        summary = partial_summary(sc, opts, "before the bench process started", stopped=name)
+        raise Stopped(early[0], summary, out)
     if not hasattr(os, "fork"):  # pragma: no cover - no supervisor where fork is missing
         from bench.operator.bench_process import run_bench
 
@@ -182,9 +212,9 @@ def run_scenario(
             assert watcher is not None
             watch_run(watcher, pid, prepare)
 
-        status, stop_signal = supervise(pid, meanwhile)
+        status, stop_signal = supervise(pid, meanwhile, early)
     else:
-        status, stop_signal = supervise(pid, prepare)
+        status, stop_signal = supervise(pid, prepare, early)
     # a stop signal from here on waits for the folder to be complete (the plots too)
     with held_stop_signals() as held:
         reserve.release()
@@ -194,6 +224,13 @@ def run_scenario(
                                       f"bench process killed by signal {os.WTERMSIG(status)}")
             _plots(opts, sc)
             raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
+        stopped = stop_signal or (held[0] if held else None) or (
+            signal.SIGINT if os.WEXITSTATUS(status) == EXIT_CHILD_STOPPED else None)
+        if stopped is not None and not (out / "summary.json").exists():
+            summary = partial_summary(sc, opts, "before the bench wrote summary.json",
+                                      stopped=signal.Signals(stopped).name)
+            _plots(opts, sc)
+            raise Stopped(stopped, summary, out)
         if not (out / "summary.json").exists():  # it failed before its run folder was set up
             summary = partial_summary(
                 sc, opts, f"bench process exited with code {os.WEXITSTATUS(status)} before "

@@ -45,11 +45,13 @@ def preload_plots() -> None:
 
 
 def partial_summary(
-    sc: Scenario, opts: Any, why: str, refused: str | None = None
+    sc: Scenario, opts: Any, why: str, refused: str | None = None, stopped: str | None = None
 ) -> dict[str, Any]:
     """summary.json rebuilt from the files a killed bench left behind (flushed as it ran).
 
     ``refused``: the bench refused its input before the run (the error, naming the key).
+    ``stopped``: a stop signal's name (SIGTERM...) ended it before the bench wrote its
+    summary: that is how it ``ended``, and ``why`` is no error but ``stopped_when``.
     """
     out = opts.out
     wait_for_exit(out)
@@ -98,6 +100,8 @@ def partial_summary(
     }
     if refused is not None:
         summary["refused"] = refused
+    if stopped is not None:
+        summary["ended"], summary["stopped_when"] = stopped, summary.pop("error")
     summary["fsw"] = fsw_report(out / "fsw_stats.json", None, out)
     merge_counts(frames, other, "FSW", summary["fsw"].get("sent", {}),
                  summary["fsw"].get("received", {}))

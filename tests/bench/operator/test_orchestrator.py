@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import json
+import os
+import signal
 import uuid
 from pathlib import Path
 
 import pytest
 
 from bench.operator import bench_process, orchestrator
+from bench.operator.lifecycle import Stopped
 from bench.operator.run_warnings import duration_warnings, overrun_warning
 from bench.scenario.load import load_scenario
 from dbc.errors import ConfigError, RefusedConfigError
@@ -73,6 +76,60 @@ def test_bench_refusing_its_input_before_the_run_says_why(
     assert str(bad) in str(info.value) and "the bench" in str(info.value)
     summary = json.loads((tmp_path / "run" / "summary.json").read_text(encoding="utf-8"))
     assert summary["refused"] == str(bad) and summary["passed"] is False
+
+
+def _opts(tmp_path: Path) -> orchestrator.RunOptions:
+    return orchestrator.RunOptions(mode="lockstep", bus=f"virtual:s-{uuid.uuid4().hex}",
+                                   seed=1, out=tmp_path / "run", duration_s=1.0, fsw_cmd=None)
+
+
+def _stopped_summary(tmp_path: Path, sig: signal.Signals) -> dict[str, object]:
+    """The folder a stop left: summary.json says how it ended, no error, no reserve file."""
+    out = tmp_path / "run"
+    summary: dict[str, object] = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert summary["ended"] == sig.name and summary["partial"] is True
+    assert "error" not in summary and summary["verdict"].startswith(f"STOPPED by {sig.name}")
+    assert not list(out.glob(".space-*")) and not list(out.glob("*.pid"))
+    return summary
+
+
+def test_a_stop_before_the_bench_is_forked_completes_the_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """SIGTERM once the folder has its first files, before the bench exists: held, then
+    Stopped (exit 143) with a summary that says so; the handlers are back as they were."""
+    real_reserve = orchestrator.DiskReserve
+
+    def reserve_then_signal(folder: Path) -> object:
+        os.kill(os.getpid(), signal.SIGTERM)  # held: nothing acts on it yet
+        return real_reserve(folder)
+
+    monkeypatch.setattr(orchestrator, "DiskReserve", reserve_then_signal)
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(Stopped) as info:
+        orchestrator.run_scenario(load_scenario(QUICKSTART), _opts(tmp_path))
+    assert info.value.signum == signal.SIGTERM and info.value.summary is not None
+    assert _stopped_summary(tmp_path, signal.SIGTERM)["stopped_when"] == \
+        "before the bench process started"
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_a_bench_stopped_before_its_summary_is_a_stop_not_a_run_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The group's SIGTERM reaches the bench while it is still setting up (no summary.json
+    yet): Stopped naming it and a partial summary, not a run error (exit 3)."""
+
+    def stopped_while_building(*_args: object, **_kwargs: object) -> None:
+        os.kill(os.getppid(), signal.SIGTERM)  # the supervisor gets it too, as a group does
+        raise Stopped(signal.SIGTERM)
+
+    monkeypatch.setattr(bench_process, "BenchNode", stopped_while_building)
+    with pytest.raises(Stopped) as info:
+        orchestrator.run_scenario(load_scenario(QUICKSTART), _opts(tmp_path))
+    assert info.value.signum == signal.SIGTERM
+    assert _stopped_summary(tmp_path, signal.SIGTERM)["stopped_when"] == \
+        "before the bench wrote summary.json"
 
 
 def test_overrun_warning_names_the_member_that_stalled() -> None:
