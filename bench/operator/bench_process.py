@@ -109,6 +109,7 @@ def run_bench(
     """
     out = opts.out
     stats = out / "fsw_stats.json"
+    supervisor_pid = os.getppid()  # the command; a SIGTERM after it died is its death's
     bus = open_bus(opts.bus, **mode_options(opts.bus, opts.mode))
     proc: FswProcess | None = None
     fsw_start: str | None = None
@@ -149,13 +150,17 @@ def run_bench(
         bus.shutdown()
     if isinstance(error, KeyboardInterrupt):
         error = Stopped(signal.SIGINT)
+    orphaned = isinstance(error, Stopped) and os.getppid() != supervisor_pid
     if isinstance(error, Stopped):
-        node.trace.event(node.plant.t_ns, "run_interrupted", by=error.name)
+        node.trace.event(node.plant.t_ns, "run_interrupted", by=error.name,
+                         **({"supervisor_died": True} if orphaned else {}))
     if reserve is not None:
         reserve.release()  # the summary and the last of the files get the space kept back
     summary = node.close(opts.duration_s if error is None else node.plant.t_ns / 1e9)
     summary["ended"] = ("completed" if error is None
                         else error.name if isinstance(error, Stopped) else "error")
+    if orphaned:  # SIGTERM from Linux (PR_SET_PDEATHSIG), not from a user: say whose death
+        summary["supervisor_died"] = True
     summary["fsw"] = fsw_report(stats, fsw_rc, out)
     if fsw_start is not None:
         summary["fsw"]["start"] = fsw_start

@@ -86,6 +86,8 @@ def abnormal_events(s: dict[str, Any]) -> list[str]:
         out.append(f"refused: {s['refused']}")
     if ended not in ("completed", "error", "refused"):
         out.append(f"stopped by {ended} at {s.get('sim_time_s', 0.0):.2f} s simulated")
+    if s.get("supervisor_died"):
+        out.append("the thruster-hil command died (killed?): the bench stopped the run itself")
     if s.get("error"):
         out.append(f"run error: {s['error']}")
     if s.get("files_sealed"):

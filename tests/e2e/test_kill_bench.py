@@ -71,3 +71,29 @@ def test_sigkill_of_bench_leaves_readable_files_and_no_orphan(
             os.close(fd)
     assert _processes_mentioning(str(out / "fsw_config.json")) == []
     assert (out / "fsw_stats.json").exists()
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
+def test_sigkill_of_the_command_is_said_in_the_summary(tmp_path: Path, runtime_dir: Path
+                                                        ) -> None:
+    """kill -9 of the thruster-hil command (its supervisor) mid-run: the bench gets SIGTERM
+    from Linux and completes the folder, and summary.json says the command died, not just
+    SIGTERM; no bench, prestart or flight software is left."""
+    out = tmp_path / "run"
+    with running(["run", str(QUICKSTART), "--bus", unique_bus(), "--no-plots"], out,
+                 runtime_dir, KILL_AFTER_PERCENT) as p:
+        bench_pid = int((out / "bench.pid").read_text())
+        p.kill()
+        p.wait(DEADLINE_S)
+        fd = os.pidfd_open(bench_pid)  # the orphaned bench: readable once it has exited
+        try:
+            sel = selectors.DefaultSelector()
+            sel.register(fd, selectors.EVENT_READ)
+            assert sel.select(DEADLINE_S), "the orphaned bench did not end"
+            sel.close()
+        finally:
+            os.close(fd)
+    s = json.loads((out / "summary.json").read_text())
+    assert s["ended"] == "SIGTERM" and s["supervisor_died"] is True
+    assert any("thruster-hil command died" in line for line in s["abnormal"])
+    assert _processes_mentioning(str(out)) == []
