@@ -81,7 +81,7 @@ def startup_env(env: dict[str, str] | os._Environ[str]) -> dict[str, str]:
 
 class FswPrestart:
     """A prestart process for ``module`` and the pipe to it (module docstring). Started by
-    the console (:meth:`start`); the bench process (a fork of the console) sends the one
+    the console (the constructor); the bench process (a fork of the console) sends the one
     request (:meth:`run`); the console lets go of its ends once it has forked the bench
     (:meth:`release`) and reaps it at the end (:meth:`close`)."""
 
