@@ -24,8 +24,9 @@ Ends (nothing outlives it)
     Its stdin's end of file, once the bench and the console have both let go of the pipe
     (the run is over, or the bench died): before a request it exits at once; after one,
     a child still running gets SIGTERM (what ``PR_SET_PDEATHSIG`` gives a cold child whose
-    bench dies) and SIGKILL after ``FSW_TERM_TIMEOUT_S``. The ended child stays unreaped
-    until then, so its pid is never reused while the bench may still signal it. SIGTERM or
+    bench dies) and SIGKILL after ``FSW_TERM_TIMEOUT_S``. The child is reaped only after
+    its exit code is answered, and the bench signals it through a pidfd opened when it
+    hears the pid, so a reused pid is never signalled. SIGTERM or
     SIGHUP to the prestart end it the same way: the console sends SIGTERM at its own end to
     a prestart still there (one a refused command never used may still be importing). A
     bench that waits ``START_TIMEOUT_S`` for the pid kills it and starts the command. A
@@ -104,7 +105,8 @@ class FswPrestart:
         interpreter) and ``env`` starts an interpreter as the prestart's did."""
         return (len(argv) >= 3 and argv[1:3] == ["-m", self.module]
                 and os.path.realpath(argv[0]) == os.path.realpath(sys.executable)
-                and startup_env(env) == self._startup and self._proc.stdin is not None)
+                and startup_env(env) == self._startup and self._proc.stdin is not None
+                and not self._proc.stdin.closed)
 
     def run(self, argv: list[str], env: dict[str, str], cwd: str, log: str
             ) -> PrestartedProcess | None:
@@ -163,6 +165,10 @@ class PrestartedProcess:
         self.returncode: int | None = None
         self._reader = reader
         self._request = request
+        try:  # it is unreaped until its exit is answered: this is that process
+            self._pidfd = os.pidfd_open(pid)
+        except ProcessLookupError:  # already gone: its exit record is in the pipe
+            self._pidfd = -1
 
     def poll(self) -> int | None:
         """Its exit code if it has ended, else None."""
@@ -183,14 +189,17 @@ class PrestartedProcess:
             return
         # an exit record, or the prestart gone without one (killed): it killed its child
         self.returncode = int(record.get("exit", -signal.SIGKILL))
+        if self._pidfd >= 0:
+            os.close(self._pidfd)
+            self._pidfd = -1
         with contextlib.suppress(OSError):
             self._request.close()
 
     def send_signal(self, sig: int) -> None:
-        """Signal it, unless it has ended (its pid is held until then: module docstring)."""
-        if self.poll() is None:
+        """Signal it (through its pidfd: never another process), unless it has ended."""
+        if self.poll() is None and self._pidfd >= 0:
             with contextlib.suppress(ProcessLookupError):
-                os.kill(self.pid, sig)
+                signal.pidfd_send_signal(self._pidfd, sig)
 
     def terminate(self) -> None:
         """SIGTERM."""
@@ -231,6 +240,8 @@ def _ignore(signum: int, frame: object) -> None:
 
 
 def _end(signum: int, frame: object) -> None:
+    for s in END_SIGNALS:  # once: the clean-up it starts (the child's stop) runs to the end
+        signal.signal(s, signal.SIG_IGN)
     raise SystemExit(0)
 
 
@@ -299,22 +310,28 @@ def _watch(pid: int, answered: list[bool]) -> None:
         os.close(pidfd)
 
 
-def _stop(pid: int) -> int:
-    """SIGTERM to a child still running, SIGKILL after FSW_TERM_TIMEOUT_S; reap it; its
-    exit code."""
-    done, status = os.waitpid(pid, os.WNOHANG)
-    if not done:
-        with contextlib.suppress(ProcessLookupError):
-            os.kill(pid, signal.SIGTERM)
-        pidfd = os.pidfd_open(pid)
-        try:
+def _stop(pid: int, answered: list[bool]) -> None:
+    """SIGTERM to a child still running, SIGKILL after FSW_TERM_TIMEOUT_S; its exit code
+    answered (if it was not yet) while it is still unreaped, then reap it."""
+    pidfd = os.pidfd_open(pid)
+    try:
+        if not select.select([pidfd], [], [], 0.0)[0]:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGTERM)
             if not select.select([pidfd], [], [], FSW_TERM_TIMEOUT_S)[0]:
                 with contextlib.suppress(ProcessLookupError):
                     os.kill(pid, signal.SIGKILL)
-        finally:
-            os.close(pidfd)
-        status = os.waitpid(pid, 0)[1]
-    return os.waitstatus_to_exitcode(status)
+                select.select([pidfd], [], [])
+    finally:
+        os.close(pidfd)
+    if not answered:
+        _send({"exit": _exit_code(pid)})
+    os.waitpid(pid, 0)
+
+
+def _stdin_closed() -> bool:
+    """Whether stdin is at its end of file now (the bench gone after its request)."""
+    return bool(select.select([0], [], [], 0.0)[0]) and not os.read(0, 4096)
 
 
 def serve(module: str) -> int:
@@ -337,15 +354,15 @@ def serve(module: str) -> int:
     if error is not None:
         _send({"error": error})
         return 0
-    pid = _fork(module, req)
-    _send({"pid": pid})
+    if _stdin_closed():  # the bench went while this imported: its run is over
+        return 0
     answered: list[bool] = []
+    pid = _fork(module, req)
     try:
+        _send({"pid": pid})
         _watch(pid, answered)
     finally:  # also on SIGTERM (a whole process group stopped): the bench hears the end
-        code = _stop(pid)
-        if not answered:
-            _send({"exit": code})
+        _stop(pid, answered)
     return 0
 
 

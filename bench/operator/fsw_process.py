@@ -77,7 +77,8 @@ def fsw_argv(template: str, bus: str, mode: str, out: Path, config: Path, stats:
 
 class FswProcess(Protocol):
     """The flight-software child as the bench holds it: a ``subprocess.Popen`` (started by
-    its command) or a bench.operator.warm_start.ForkedProcess (started warm)."""
+    its command), a bench.operator.warm_start.ForkedProcess (started warm) or a
+    bench.operator.fsw_prestart.PrestartedProcess (started in the console's prestart)."""
 
     @property
     def pid(self) -> int: ...

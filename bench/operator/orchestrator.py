@@ -54,7 +54,7 @@ from transport.relay import RelayBus
 from transport.spec import open_bus
 
 EXIT_CHILD_OK, EXIT_CHILD_RUN_ERROR, EXIT_CHILD_CRASH, EXIT_CHILD_BAD_INPUT = 0, 3, 4, 5
-EXIT_CHILD_STOPPED = 6  # a stop signal: the run folder is complete, the parent re-raises it
+EXIT_CHILD_STOPPED_BASE = 64  # + the signal's number: stopped by it, the parent re-raises it
 
 
 @dataclass(frozen=True)
@@ -104,8 +104,9 @@ def run_scenario(
     The bench runs in a forked child process and this process supervises it, so that the
     run folder is completed (from the files written so far) even if the bench is killed.
     """
-    # from here (the run folder exists) until the bench is forked a stop signal waits: the
-    # folder is then completed, with the bench or without it
+    # from here (the run folder exists) a stop signal waits until the bench is supervised
+    # (then forwarded to it), or completes the folder without a bench; after the run, one
+    # still held here stops the command as the others do
     with held_stop_signals() as early:
         out = opts.out
         if opts.fsw_cmd is not None:
@@ -177,6 +178,8 @@ def _fork_and_supervise(
         try:
             die_with_parent()
             stop_on_signals()
+            if early:  # one came between the fork and the line above (this copy's list)
+                raise Stopped(early[0])
             (out / "bench.pid").write_text(f"{os.getpid()}\n", encoding="utf-8")
             # imported here, after the fork: the supervisor never loads the bench's models,
             # and the flight software starts before they load (bench.operator.bench_process)
@@ -190,8 +193,10 @@ def _fork_and_supervise(
                 partial_summary(sc, opts, f"bad input: {exc}", refused=str(exc))
         except RunError:
             code = EXIT_CHILD_RUN_ERROR
-        except (Stopped, KeyboardInterrupt):
-            code = EXIT_CHILD_STOPPED
+        except Stopped as exc:
+            code = EXIT_CHILD_STOPPED_BASE + exc.signum
+        except KeyboardInterrupt:
+            code = EXIT_CHILD_STOPPED_BASE + signal.SIGINT
         except BaseException:
             code = EXIT_CHILD_CRASH
             if not (out / "summary.json").exists():
@@ -215,6 +220,12 @@ def _fork_and_supervise(
         status, stop_signal = supervise(pid, meanwhile, early)
     else:
         status, stop_signal = supervise(pid, prepare, early)
+    # the bench's own stop (a signal to it alone has its number in the exit code)
+    code = os.WEXITSTATUS(status) if os.WIFEXITED(status) else -1
+    bench_stop = (code - EXIT_CHILD_STOPPED_BASE
+                  if EXIT_CHILD_STOPPED_BASE < code < EXIT_CHILD_STOPPED_BASE + signal.NSIG
+                  else None)
+    late = len(early)  # held from here on by run_scenario's block: read at the end
     # a stop signal from here on waits for the folder to be complete (the plots too)
     with held_stop_signals() as held:
         reserve.release()
@@ -224,8 +235,7 @@ def _fork_and_supervise(
                                       f"bench process killed by signal {os.WTERMSIG(status)}")
             _plots(opts, sc)
             raise RunError(f"run failed ({summary['error']}); partial run folder: {out}")
-        stopped = stop_signal or (held[0] if held else None) or (
-            signal.SIGINT if os.WEXITSTATUS(status) == EXIT_CHILD_STOPPED else None)
+        stopped = stop_signal or (held[0] if held else None) or bench_stop
         if stopped is not None and not (out / "summary.json").exists():
             summary = partial_summary(sc, opts, "before the bench wrote summary.json",
                                       stopped=signal.Signals(stopped).name)
@@ -242,10 +252,10 @@ def _fork_and_supervise(
                 os.WEXITSTATUS(status) == EXIT_CHILD_OK:
             summary_ready(summary)
         _plots(opts, sc)
-    stop_signal = stop_signal or (held[0] if held else None)
-    if os.WEXITSTATUS(status) == EXIT_CHILD_STOPPED or stop_signal is not None:
-        # after the bench completed the folder
-        raise Stopped(stop_signal or signal.SIGINT, summary, out)
+    stop_signal = (stop_signal or (held[0] if held else None)
+                   or (early[late] if len(early) > late else None) or bench_stop)
+    if stop_signal is not None:  # after the bench completed the folder
+        raise Stopped(stop_signal, summary, out)
     if os.WEXITSTATUS(status) == EXIT_CHILD_BAD_INPUT:
         if summary.get("refused"):
             raise RefusedConfigError("the bench", summary["refused"])

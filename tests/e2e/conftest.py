@@ -89,7 +89,7 @@ def _default_sigint() -> None:
 @contextlib.contextmanager
 def running(
     args: list[str], out: Path, runtime_dir: Path, min_percent: float = 0.0,
-    own_group: bool = False,
+    own_group: bool = False, env_extra: dict[str, str] | None = None,
 ) -> Iterator[subprocess.Popen[str]]:
     """``thruster-hil ARGS --out OUT`` in the background, entered once its progress passes
     ``min_percent``; on exit it is waited for (and killed if a test failed meanwhile).
@@ -98,7 +98,7 @@ def running(
     so that a signal can go to all its processes at once (``os.killpg``), and with SIGINT
     at its default disposition as a terminal gives it (a background job of a
     non-interactive shell, such as a CI runner's, inherits it ignored)."""
-    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir))
+    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir), **(env_extra or {}))
     p = subprocess.Popen(
         [sys.executable, "-m", "bench.operator.entry", *args, "--out", str(out)],
         cwd=REPO,

@@ -6,6 +6,7 @@ import json
 import os
 import selectors
 import signal
+import uuid
 from pathlib import Path
 
 import can
@@ -18,19 +19,44 @@ from tests.run_files import run_text
 pytestmark = pytest.mark.slow
 
 DEADLINE_S = 60.0
+MARK_VAR = "THIL_TEST_RUN_MARK"
 KILL_AFTER_PERCENT = 30.0
 
 
-def _processes_mentioning(text: str) -> list[int]:
+def _processes_with(mark: str) -> list[int]:
+    """The processes whose environment holds ``mark`` (a run's own: its bench, prestart and
+    flight software inherit it, whatever their command lines)."""
     pids = []
     for entry in Path("/proc").iterdir():
         if entry.name.isdigit():
             try:
-                if text in (entry / "cmdline").read_bytes().decode(errors="replace"):
+                if mark.encode() in (entry / "environ").read_bytes():
                     pids.append(int(entry.name))
             except OSError:
                 continue
     return pids
+
+
+def _all_end(mark: str) -> None:
+    """Wait (up to DEADLINE_S each) for every process of the run marked ``mark`` to end;
+    then none is left."""
+    for pid in _processes_with(mark):
+        try:
+            fd = os.pidfd_open(pid)
+        except ProcessLookupError:
+            continue
+        try:  # the pidfd becomes readable when the process exits
+            waiter = selectors.DefaultSelector()
+            waiter.register(fd, selectors.EVENT_READ)
+            assert waiter.select(timeout=DEADLINE_S), f"process {pid} of the run still running"
+            waiter.close()
+        finally:
+            os.close(fd)
+    assert _processes_with(mark) == []
+
+
+def _mark() -> str:
+    return f"thil-kill-{uuid.uuid4().hex}"
 
 
 @pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs /proc (Linux)")
@@ -38,9 +64,10 @@ def test_sigkill_of_bench_leaves_readable_files_and_no_orphan(
     tmp_path: Path, runtime_dir: Path
 ) -> None:
     """After kill -9 of the bench: partial summary, trace and telemetry parse, FSW exits."""
-    out = tmp_path / "run"
+    out, mark = tmp_path / "run", _mark()
     with running(
-        ["run", str(QUICKSTART), "--bus", unique_bus()], out, runtime_dir, KILL_AFTER_PERCENT
+        ["run", str(QUICKSTART), "--bus", unique_bus()], out, runtime_dir, KILL_AFTER_PERCENT,
+        env_extra={MARK_VAR: mark},
     ) as p:
         os.kill(int((out / "bench.pid").read_text()), signal.SIGKILL)  # the bench, not its
         p.wait(DEADLINE_S)  # supervisor: that one completes the folder and exits
@@ -56,20 +83,8 @@ def test_sigkill_of_bench_leaves_readable_files_and_no_orphan(
     assert len(frames) > 1000
     rows = run_text(out, "telemetry.csv").splitlines()
     assert len(rows) > 100 and all(len(r.split(",")) == len(rows[0].split(",")) for r in rows[1:-1])
-    # the flight-software child got SIGTERM from the kernel and wrote its statistics
-    for pid in _processes_mentioning(str(out / "fsw_config.json")):
-        try:
-            fd = os.pidfd_open(pid)
-        except ProcessLookupError:
-            continue
-        try:  # the pidfd becomes readable when the process exits
-            waiter = selectors.DefaultSelector()
-            waiter.register(fd, selectors.EVENT_READ)
-            assert waiter.select(timeout=DEADLINE_S), f"flight software {pid} still running"
-            waiter.close()
-        finally:
-            os.close(fd)
-    assert _processes_mentioning(str(out / "fsw_config.json")) == []
+    # the flight software got SIGTERM and wrote its statistics; the prestart ended with it
+    _all_end(mark)
     assert (out / "fsw_stats.json").exists()
 
 
@@ -79,9 +94,9 @@ def test_sigkill_of_the_command_is_said_in_the_summary(tmp_path: Path, runtime_d
     """kill -9 of the thruster-hil command (its supervisor) mid-run: the bench gets SIGTERM
     from Linux and completes the folder, and summary.json says the command died, not just
     SIGTERM; no bench, prestart or flight software is left."""
-    out = tmp_path / "run"
+    out, mark = tmp_path / "run", _mark()
     with running(["run", str(QUICKSTART), "--bus", unique_bus(), "--no-plots"], out,
-                 runtime_dir, KILL_AFTER_PERCENT) as p:
+                 runtime_dir, KILL_AFTER_PERCENT, env_extra={MARK_VAR: mark}) as p:
         bench_pid = int((out / "bench.pid").read_text())
         p.kill()
         p.wait(DEADLINE_S)
@@ -96,4 +111,4 @@ def test_sigkill_of_the_command_is_said_in_the_summary(tmp_path: Path, runtime_d
     s = json.loads((out / "summary.json").read_text())
     assert s["ended"] == "SIGTERM" and s["supervisor_died"] is True
     assert any("thruster-hil command died" in line for line in s["abnormal"])
-    assert _processes_mentioning(str(out)) == []
+    _all_end(mark)

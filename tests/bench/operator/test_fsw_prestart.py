@@ -104,7 +104,8 @@ def test_the_command_runs_with_its_argv_environment_folder_and_log(
 
 
 def test_a_signal_reaches_the_child_and_its_exit_is_reported(
-        prestart: FswPrestart, program: str, tmp_path: Path) -> None:
+        prestart: FswPrestart, program: str, tmp_path: Path,
+        monkeypatch: pytest.MonkeyPatch) -> None:
     """wait() times out while it runs; SIGTERM ends it (its handler: exit 0), SIGKILL
     gives -9; signalling an ended child is a no-op."""
     log = tmp_path / "fsw.log"
@@ -117,6 +118,11 @@ def test_a_signal_reaches_the_child_and_its_exit_is_reported(
     proc.terminate()
     assert proc.wait(WAIT_S) == 0
     assert "terminated" in log.read_text(encoding="utf-8")
+
+    def must_not_signal(*_args: object) -> None:
+        raise AssertionError("an ended child was signalled")
+
+    monkeypatch.setattr(signal, "pidfd_send_signal", must_not_signal)
     proc.kill()  # ended: nothing is signalled
     assert proc.returncode == 0
 
@@ -160,11 +166,17 @@ def test_without_a_request_it_ends_with_its_pipe(prestart: FswPrestart) -> None:
     assert prestart._proc.wait(WAIT_S) == 0
 
 
-def test_the_console_end_stops_one_still_importing(prestart: FswPrestart) -> None:
-    """close() at the console's end: a prestart still there gets SIGTERM (0 from its
-    handler, or -SIGTERM before the interpreter set it), whatever it was doing."""
-    prestart.close()
-    assert prestart._proc.returncode in ENDED_BY_CLOSE
+def test_the_console_end_stops_one_still_there(prestart: FswPrestart) -> None:
+    """close() at the console's end: a prestart whose pipe is still open elsewhere (no end
+    of file would end it) gets SIGTERM (0 from its handler, or -SIGTERM before the
+    interpreter set it), whatever it was doing."""
+    assert prestart._proc.stdin is not None
+    held = os.dup(prestart._proc.stdin.fileno())  # another holder of the request pipe
+    try:
+        prestart.close()
+        assert prestart._proc.returncode in ENDED_BY_CLOSE
+    finally:
+        os.close(held)
 
 
 def test_another_command_or_interpreter_set_up_is_not_its_to_run(
@@ -186,9 +198,10 @@ def test_failed_imports_answer_none(tmp_path: Path) -> None:
     try:
         argv = [sys.executable, "-m", "no_such_module_for_prestart"]
         assert p.run(argv, dict(os.environ), str(tmp_path), str(tmp_path / "log")) is None
+        p.release()
+        assert p._proc.wait(WAIT_S) == 0  # it answered the error and ended (a crash: 1)
     finally:
         p.close()
-    assert p._proc.returncode in ENDED_BY_CLOSE
 
 
 @pytest.mark.parametrize(("argv", "expected"), [
