@@ -151,3 +151,15 @@ def flood(bus: str, runtime_dir: Path, frames: int, rate_hz: float) -> dict[str,
         check=True,
     )
     return dict(json.loads(done.stdout))
+
+
+def processes_with(mark: str) -> list[int]:
+    """Pids of the processes whose environment holds ``mark`` (a run's own: its console,
+    bench, prestart and flight software inherit it, whatever their command lines)."""
+    found = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            with contextlib.suppress(OSError):
+                if mark.encode() in (d / "environ").read_bytes():
+                    found.append(int(d.name))
+    return found

@@ -13,7 +13,7 @@ import can
 import pytest
 
 from bench.results.record import is_whole, run_file
-from tests.e2e.conftest import QUICKSTART, running, unique_bus
+from tests.e2e.conftest import QUICKSTART, processes_with, running, unique_bus
 from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
@@ -23,24 +23,10 @@ MARK_VAR = "THIL_TEST_RUN_MARK"
 KILL_AFTER_PERCENT = 30.0
 
 
-def _processes_with(mark: str) -> list[int]:
-    """The processes whose environment holds ``mark`` (a run's own: its bench, prestart and
-    flight software inherit it, whatever their command lines)."""
-    pids = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                if mark.encode() in (entry / "environ").read_bytes():
-                    pids.append(int(entry.name))
-            except OSError:
-                continue
-    return pids
-
-
 def _all_end(mark: str) -> None:
     """Wait (up to DEADLINE_S each) for every process of the run marked ``mark`` to end;
     then none is left."""
-    for pid in _processes_with(mark):
+    for pid in processes_with(mark):
         try:
             fd = os.pidfd_open(pid)
         except ProcessLookupError:
@@ -52,7 +38,7 @@ def _all_end(mark: str) -> None:
             waiter.close()
         finally:
             os.close(fd)
-    assert _processes_with(mark) == []
+    assert processes_with(mark) == []
 
 
 def _mark() -> str:

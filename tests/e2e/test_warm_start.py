@@ -19,7 +19,7 @@ import pytest
 
 from bench.campaign.zygote import Zygote
 from bench.operator.fsw_prestart import PRESTART_ENV
-from tests.e2e.conftest import QUICKSTART, run_cli, unique_bus
+from tests.e2e.conftest import QUICKSTART, processes_with, run_cli, unique_bus
 from tests.run_files import run_text
 
 pytestmark = pytest.mark.slow
@@ -103,17 +103,6 @@ def test_a_prestarted_run_equals_the_cold_command(tmp_path: Path, runtime_dir: P
         assert s["fsw"]["exit_code"] == 0 and s["fsw"]["sent"], s["fsw"]
 
 
-def _processes_with(mark: bytes) -> list[int]:
-    """Pids of the processes whose environment holds ``mark``."""
-    found = []
-    for d in Path("/proc").iterdir():
-        if d.name.isdigit():
-            with contextlib.suppress(OSError):
-                if mark in (d / "environ").read_bytes():
-                    found.append(int(d.name))
-    return found
-
-
 def test_a_refused_run_leaves_no_prestart_behind(tmp_path: Path, runtime_dir: Path) -> None:
     """A run refused before its bench (a bad --duration) exits 2 at once: its prestart,
     maybe still importing, ended with it (no process of the command is left)."""
@@ -124,4 +113,4 @@ def test_a_refused_run_leaves_no_prestart_behind(tmp_path: Path, runtime_dir: Pa
                            "--out", str(tmp_path / "out")], env=env, capture_output=True,
                           text=True, timeout=TIMEOUT_S)
     assert done.returncode == 2 and "--duration" in done.stderr, done.stderr
-    assert _processes_with(mark.encode()) == []
+    assert processes_with(mark) == []
