@@ -7,7 +7,8 @@ What and why
     packing, frame encoding and checks; flight_sw: 3-vector algebra, quaternions, dual
     quaternions, the pose laws' error state, NFTSM and TSM, the anti-unwinding error,
     PWPF, the dense solver (Cholesky, Jacobi SVD) and the allocators' box-QP and
-    least-squares kernels, the RLS identifier's kernel) are plain, fully typed Python.
+    least-squares kernels, the RLS identifier's kernel, the FDIR's expected-thrust
+    model) are plain, fully typed Python.
     mypyc (mypy's compiler, https://mypyc.readthedocs.io) turns each into a C extension
     that Python imports instead of the ``.py`` beside it; the arithmetic is the same IEEE
     double arithmetic in the same order (no fused multiply-add on the x86-64 baseline), so
@@ -101,6 +102,7 @@ COMPILED = [
     "flight_sw/allocation/dense.py",
     "flight_sw/allocation/dense_active_set.py",
     "flight_sw/estimation/rls_kernel.py",
+    "flight_sw/fdir/thrust_model.py",
 ]
 PURE_ENV = "THRUSTER_HIL_PURE"
 PACKAGES = ("bench", "dbc", "flight_sw")

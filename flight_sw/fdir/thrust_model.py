@@ -21,13 +21,21 @@ A thruster declared stuck open is at full thrust all the time.
 
 Inputs: the valve timing (:class:`flight_sw.fdir.valve_timing.ValveTiming`: command delay
 δ, opening and closing delays, rise and tail time constants); ``command(t_ns,
-on_time_s)`` per control cycle, in time order. Outputs: see above;
-fractions are dimensionless, times integer ns in, seconds out.
+on_time_s)`` per control cycle, in time order. Outputs: see above (numpy arrays, one
+entry per thruster); fractions are dimensionless, times integer ns in, seconds out.
+
+Computation: on Python floats, compiled with mypyc (setup.py): each thruster keeps its
+finished segments in time order, and a query visits only those that reach its window
+(from the newest back), so a cycle's queries cost a few segments each, not all of them
+(the FDIR runs every cycle of a 16-thruster vehicle: issue 23). The per-thruster sums
+add the segments in time order. ``tests/flight_sw/thrust_model_reference.py`` is the
+array form it is checked against.
 
 Assumptions: the valve parameters are the vehicle's nominal ones (a valve that differs
 shows up as a residual, which is the point); the command delay is the same for every
 thruster (in lockstep it varies by ~0.4 ms with the frame order: the timing term of the
-residual's uncertainty covers it); segments older than ``horizon_ns`` are dropped.
+residual's uncertainty covers it); segments that ended more than ``horizon_ns`` before
+the newest command are dropped.
 
 Source: first-order valve with transport delays, as the bench's valve model and e.g.
 Wertz & Larson (eds.) 1999, "Space Mission Analysis and Design", 3rd ed. (pulse-mode
@@ -45,10 +53,12 @@ from flight_sw.fdir.valve_timing import ValveTiming
 NS_PER_S = 1_000_000_000
 S_PER_NS = 1e-9
 INF_NS = 2**62
-SEGMENT_CAPACITY = 1024  # initial rows of the finished-segment arrays (they grow if needed)
 # A rise or tail time constant below this [s] is taken as this (an instant edge: the
 # exponentials stay finite).
 MIN_TIME_CONSTANT_S = 1e-6
+
+# A segment: (start_ns, end_ns, F0, target, tau_s).
+Segment = tuple[int, int, float, float, float]
 
 
 class ThrustModel:
@@ -66,7 +76,14 @@ class ThrustModel:
         self._tau_r = max(timing.rise_tau_s, MIN_TIME_CONSTANT_S)
         self._tau_t = max(timing.tail_tau_s, MIN_TIME_CONSTANT_S)
         self._horizon_ns = horizon_ns
-        self.stuck_open = np.zeros(n_thrusters, dtype=bool)
+        #: True = known stuck open (set by the FDIR; read at each query)
+        self.stuck_open: np.ndarray = np.zeros(n_thrusters, dtype=bool)
+        self._coil_on: list[int] = []
+        self._coil_off: list[int] = []
+        self._drive_on: list[int] = []
+        self._drive_off: list[int] = []
+        self._f_drive_on: list[float] = []
+        self._done: list[list[Segment]] = []
         self.reset()
 
     def reset(self) -> None:
@@ -77,150 +94,143 @@ class ThrustModel:
         self._drive_on = [-INF_NS] * n  # current (last) drive interval
         self._drive_off = [-INF_NS] * n
         self._f_drive_on = [0.0] * n  # thrust fraction when the last drive interval began
-        # finished segments, rows [lo, hi) of: thruster, start_ns, end_ns (int64);
-        # F0, target, tau_s (float)
-        self._seg_i = np.zeros((SEGMENT_CAPACITY, 3), dtype=np.int64)
-        self._seg_f = np.zeros((SEGMENT_CAPACITY, 3))
-        self._lo = self._hi = 0
+        self._done = [[] for _ in range(n)]  # finished segments per thruster, in time order
         self.stuck_open[:] = False
-        self._t_last = -INF_NS
-        self._cache: tuple[np.ndarray, ...] | None = None
 
     # --- building -----------------------------------------------------------------------
-
-    def _archive(self, k: int, start: int, end: int, f0: float, target: float, tau: float) -> None:
-        """Append one finished segment (compacting or growing the arrays when full)."""
-        if self._hi == len(self._seg_i):
-            live = self._hi - self._lo
-            if live > len(self._seg_i) // 2:  # grow
-                self._seg_i = np.concatenate((self._seg_i, np.zeros_like(self._seg_i)))
-                self._seg_f = np.concatenate((self._seg_f, np.zeros_like(self._seg_f)))
-            self._seg_i[:live] = self._seg_i[self._lo : self._hi]
-            self._seg_f[:live] = self._seg_f[self._lo : self._hi]
-            self._lo, self._hi = 0, live
-        i = self._hi
-        self._seg_i[i] = (k, start, end)
-        self._seg_f[i] = (f0, target, tau)
-        self._hi += 1
 
     def _close_drive(self, k: int, until_ns: int) -> float:
         """Archive thruster k's last drive interval and its tail up to ``until_ns``."""
         on, off, f0 = self._drive_on[k], self._drive_off[k], self._f_drive_on[k]
         if on == -INF_NS:
             return 0.0
-        self._archive(k, on, off, f0, 1.0, self._tau_r)
+        done = self._done[k]
+        done.append((on, off, f0, 1.0, self._tau_r))
         f_off = 1.0 + (f0 - 1.0) * math.exp(-(off - on) * S_PER_NS / self._tau_r)
-        self._archive(k, off, until_ns, f_off, 0.0, self._tau_t)
+        done.append((off, until_ns, f_off, 0.0, self._tau_t))
         return f_off * math.exp(-(until_ns - off) * S_PER_NS / self._tau_t)
 
     def command(self, t_ns: int, on_time_s: np.ndarray) -> None:
         """The on-times [s] commanded for the period starting at ``t_ns``."""
         t_rx = t_ns + self._delay_ns
-        self._t_last = t_rx
-        self._cache = None
-        d = np.asarray(on_time_s, dtype=float)
-        for k in np.flatnonzero(d[: self.n] > 0.0).tolist():
-            on_ns = round(float(d[k]) * NS_PER_S)
-            if self._coil_on[k] <= t_rx <= self._coil_off[k]:  # continues the pulse
-                self._coil_off[k] = max(t_rx + on_ns, self._coil_on[k] + self._min_on_ns)
-            else:
-                self._coil_on[k] = t_rx
-                self._coil_off[k] = t_rx + max(on_ns, self._min_on_ns)
-            drive_on = self._coil_on[k] + self._od_ns
-            drive_off = self._coil_off[k] + self._cd_ns
-            if drive_off <= drive_on:
-                continue
-            if self._drive_on[k] != -INF_NS and drive_on <= self._drive_off[k]:
-                self._drive_off[k] = max(self._drive_off[k], drive_off)  # merge
-            else:
-                f0 = self._close_drive(k, drive_on)
-                self._drive_on[k], self._drive_off[k], self._f_drive_on[k] = (
-                    drive_on,
-                    drive_off,
-                    f0,
-                )
-        for k in np.flatnonzero(d[: self.n] <= 0.0).tolist():  # a 0 switches the coil off
-            if self._coil_on[k] <= t_rx < self._coil_off[k]:
+        d: list[float] = [float(x) for x in np.asarray(on_time_s, dtype=float)[: self.n].tolist()]
+        for k in range(len(d)):
+            if d[k] > 0.0:
+                self._fire(k, t_rx, round(d[k] * NS_PER_S))
+        for k in range(len(d)):  # a 0 switches the coil off
+            if d[k] <= 0.0 and self._coil_on[k] <= t_rx < self._coil_off[k]:
                 self._coil_off[k] = t_rx
                 self._drive_off[k] = max(self._drive_on[k], t_rx + self._cd_ns)
         horizon = t_ns - self._horizon_ns
-        while self._lo < self._hi and self._seg_i[self._lo, 2] < horizon:
-            self._lo += 1
+        for done in self._done:
+            drop = 0
+            while drop < len(done) and done[drop][1] < horizon:
+                drop += 1
+            if drop:
+                del done[:drop]
 
-    def _segments(self) -> tuple[np.ndarray, ...]:
-        """All segments as arrays (thruster, start, end, F0, target, tau); cached."""
-        if self._cache is None:
-            self._cache = self._build_segments()
-        return self._cache
+    def _fire(self, k: int, t_rx: int, on_ns: int) -> None:
+        """Thruster k commanded on for ``on_ns`` from ``t_rx`` (module docstring)."""
+        if self._coil_on[k] <= t_rx <= self._coil_off[k]:  # continues the pulse
+            self._coil_off[k] = max(t_rx + on_ns, self._coil_on[k] + self._min_on_ns)
+        else:
+            self._coil_on[k] = t_rx
+            self._coil_off[k] = t_rx + max(on_ns, self._min_on_ns)
+        drive_on = self._coil_on[k] + self._od_ns
+        drive_off = self._coil_off[k] + self._cd_ns
+        if drive_off <= drive_on:
+            return
+        if self._drive_on[k] != -INF_NS and drive_on <= self._drive_off[k]:
+            self._drive_off[k] = max(self._drive_off[k], drive_off)  # merge
+        else:
+            f0 = self._close_drive(k, drive_on)
+            self._drive_on[k] = drive_on
+            self._drive_off[k] = drive_off
+            self._f_drive_on[k] = f0
 
-    def _build_segments(self) -> tuple[np.ndarray, ...]:
-        on = np.array(self._drive_on, dtype=np.int64)
-        off = np.array(self._drive_off, dtype=np.int64)
-        f0 = np.array(self._f_drive_on)
-        k = np.flatnonzero(on != -INF_NS)
-        on, off, f0 = on[k], off[k], f0[k]
-        f_off = 1.0 + (f0 - 1.0) * np.exp(-(off - on) * S_PER_NS / self._tau_r)
-        seg_i = self._seg_i[self._lo : self._hi]
-        seg_f = self._seg_f[self._lo : self._hi]
-        ones, zeros = np.ones(k.size), np.zeros(k.size)
-        return (
-            np.concatenate((seg_i[:, 0], k, k)),
-            np.concatenate((seg_i[:, 1], on, off)),
-            np.concatenate((seg_i[:, 2], off, np.full(k.size, INF_NS, dtype=np.int64))),
-            np.concatenate((seg_f[:, 0], f0, f_off)),
-            np.concatenate((seg_f[:, 1], ones, zeros)),
-            np.concatenate((seg_f[:, 2], ones * self._tau_r, ones * self._tau_t)),
-        )
+    def _current(self, k: int) -> list[Segment]:
+        """Thruster k's current drive interval and its open-ended tail (none if it never
+        fired)."""
+        on = self._drive_on[k]
+        if on == -INF_NS:
+            return []
+        off, f0 = self._drive_off[k], self._f_drive_on[k]
+        f_off = 1.0 + (f0 - 1.0) * math.exp(-(off - on) * S_PER_NS / self._tau_r)
+        return [(on, off, f0, 1.0, self._tau_r), (off, INF_NS, f_off, 0.0, self._tau_t)]
+
+    def _ending_after(self, k: int, t_ns: int) -> list[Segment]:
+        """Thruster k's segments that end after ``t_ns``, in time order, and the current
+        ones (whenever they end): the finished ones end in time order, so those that end
+        after ``t_ns`` are a tail of the list."""
+        done = self._done[k]
+        i = len(done)
+        while i > 0 and done[i - 1][1] > t_ns:
+            i -= 1
+        return done[i:] + self._current(k)
 
     # --- queries ------------------------------------------------------------------------
 
     def thrust_time_s(self, t_a_ns: int, t_b_ns: int) -> np.ndarray:
         """∫ thrust/T_max over [t_a, t_b] per thruster [s] (stuck open: t_b − t_a)."""
-        thr, s, e, f0, tgt, tau = self._segments()
-        out = np.zeros(self.n)
-        if thr.size:
-            u1 = np.maximum(s, t_a_ns)
-            u2 = np.minimum(e, t_b_ns)
-            ok = u2 > u1
-            if ok.any():
-                thr, s, u1, u2, f0, tgt, tau = (x[ok] for x in (thr, s, u1, u2, f0, tgt, tau))
+        stuck: list[bool] = self.stuck_open.tolist()
+        out = [0.0] * self.n
+        for k in range(self.n):
+            if stuck[k]:
+                out[k] = (t_b_ns - t_a_ns) * S_PER_NS
+                continue
+            acc = 0.0
+            for s, e, f0, tgt, tau in self._ending_after(k, t_a_ns):
+                if s >= t_b_ns:
+                    break
+                if e <= t_a_ns:  # the current drive interval may have ended before t_a
+                    continue
+                u1 = s if s > t_a_ns else t_a_ns
+                u2 = e if e < t_b_ns else t_b_ns
                 x1 = (u1 - s) * S_PER_NS / tau
                 x2 = (u2 - s) * S_PER_NS / tau
-                val = tgt * (u2 - u1) * S_PER_NS + (f0 - tgt) * tau * (np.exp(-x1) - np.exp(-x2))
-                out = np.bincount(thr, weights=val, minlength=self.n).astype(float)
-        out[self.stuck_open] = (t_b_ns - t_a_ns) * S_PER_NS
-        return out
+                acc += (tgt * (u2 - u1) * S_PER_NS
+                        + (f0 - tgt) * tau * (math.exp(-x1) - math.exp(-x2)))
+            out[k] = acc
+        return np.array(out)
 
     def boundary_segments(self, t_ns: int, guard_ns: int) -> np.ndarray:
         """Per thruster, drive intervals with an edge within ``guard_ns`` of ``t_ns``."""
-        count = np.zeros(self.n)
-        thr, s, e, _, tgt, _ = self._segments()
-        if thr.size:
-            rising = tgt > 0.0
-            near = rising & ((np.abs(s - t_ns) < guard_ns) | (np.abs(e - t_ns) < guard_ns))
-            near |= rising & (s < t_ns) & (e > t_ns) & ((e - s) < 2 * guard_ns)
-            count = np.bincount(thr[near], minlength=self.n).astype(float)
-        count[self.stuck_open] = 0.0
-        return count
+        stuck: list[bool] = self.stuck_open.tolist()
+        count = [0.0] * self.n
+        for k in range(self.n):
+            if stuck[k]:
+                continue
+            c = 0
+            # a drive interval near t ends after t − guard (edges near t, or t inside it)
+            for s, e, _f0, tgt, _tau in self._ending_after(k, t_ns - guard_ns):
+                if tgt > 0.0 and (abs(s - t_ns) < guard_ns or abs(e - t_ns) < guard_ns
+                                  or (s < t_ns < e and e - s < 2 * guard_ns)):
+                    c += 1
+            count[k] = float(c)
+        return np.array(count)
 
     def fraction_at(self, t_ns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(F/T_max, |dF/dt|/T_max [1/s]) at the sample times ``t_ns``, shape (samples, n)."""
-        ts = np.asarray(t_ns, dtype=np.int64)
-        frac = np.zeros((ts.size, self.n))
-        rate = np.zeros((ts.size, self.n))
-        thr, s, e, f0, tgt, tau = self._segments()
-        if thr.size and ts.size:
-            near = (e > ts.min()) & (s <= ts.max())  # only the segments around the samples
-            thr, s, e, f0, tgt, tau = (x[near] for x in (thr, s, e, f0, tgt, tau))
-        if thr.size and ts.size:
-            inside = (ts[:, None] >= s[None, :]) & (ts[:, None] < e[None, :])
-            x = np.where(inside, (ts[:, None] - s[None, :]) * S_PER_NS / tau[None, :], 0.0)
-            f = np.where(inside, tgt + (f0 - tgt) * np.exp(-x), 0.0)
-            r = np.where(inside, np.abs(tgt - f) / tau[None, :], 0.0)
-            onehot = np.zeros((thr.size, self.n))
-            onehot[np.arange(thr.size), thr] = 1.0
-            frac = f @ onehot
-            rate = r @ onehot
-        frac[:, self.stuck_open] = 1.0
-        rate[:, self.stuck_open] = 0.0
-        return frac, rate
+        ts: list[int] = [int(t) for t in np.asarray(t_ns, dtype=np.int64).tolist()]
+        n = self.n
+        if not ts:
+            return np.zeros((0, n)), np.zeros((0, n))
+        stuck: list[bool] = self.stuck_open.tolist()
+        frac = [[0.0] * n for _ in ts]
+        rate = [[0.0] * n for _ in ts]
+        first = min(ts)
+        for k in range(n):
+            if stuck[k]:
+                for row in frac:
+                    row[k] = 1.0
+                continue
+            segs = self._ending_after(k, first)
+            for m in range(len(ts)):
+                t = ts[m]
+                for s, e, f0, tgt, tau in segs:
+                    if s <= t < e:  # the one segment holding t (they do not overlap)
+                        f = tgt + (f0 - tgt) * math.exp(-((t - s) * S_PER_NS / tau))
+                        frac[m][k] = f
+                        rate[m][k] = abs(tgt - f) / tau
+                        break
+        return np.array(frac), np.array(rate)

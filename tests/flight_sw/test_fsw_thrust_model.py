@@ -9,6 +9,7 @@ import pytest
 
 from flight_sw.fdir.thrust_model import ThrustModel
 from flight_sw.fdir.valve_timing import DEFAULT_TIMING
+from tests.flight_sw.thrust_model_reference import ReferenceThrustModel
 
 N = 4
 NS = 1_000_000_000
@@ -99,3 +100,46 @@ def test_stuck_open_is_full_thrust() -> None:
     m.stuck_open[3] = True
     assert m.thrust_time_s(0, 300_000_000)[3] == pytest.approx(0.3)
     assert m.fraction_at(np.array([1, 2]))[0][:, 3] == pytest.approx(1.0)
+
+
+# --- the package's float form against the array form (tests/flight_sw/thrust_model_reference.py)
+
+EQUIVALENCE_RTOL = 1e-12  # the two use different exp implementations (an ulp apart at most)
+N_RANDOM = 16  # the fdir_16thr vehicle
+RANDOM_CYCLES = 120
+EDGE_GUARD_NS = 1_000_000  # 2 × the residual FDIR's edge uncertainty
+
+
+def _random_on_times(rng: np.random.Generator) -> np.ndarray:
+    """A PWPF-like command: most thrusters off, some short pulses, some whole periods."""
+    on = np.where(rng.random(N_RANDOM) < 0.3, rng.uniform(0.0, 0.025, N_RANDOM), 0.0)
+    on[rng.random(N_RANDOM) < 0.05] = PERIOD_NS / NS  # continuous firing
+    return on
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_float_form_matches_the_array_form(seed: int) -> None:
+    """Every query of the float model equals the array reference's after each command,
+    with stuck-open thrusters and pruning beyond the horizon."""
+    rng = np.random.default_rng(seed)
+    horizon_ns = 300_000_000
+    fast = ThrustModel(N_RANDOM, MIN_ON_S, DEFAULT_TIMING, horizon_ns)
+    ref = ReferenceThrustModel(N_RANDOM, MIN_ON_S, DEFAULT_TIMING, horizon_ns)
+    for k in range(RANDOM_CYCLES):
+        t = k * PERIOD_NS
+        on = _random_on_times(rng)
+        fast.command(t, on)
+        ref.command(t, on)
+        if k == RANDOM_CYCLES // 2:
+            fast.stuck_open[5] = ref.stuck_open[5] = True
+        t_a = t - 200_000_000 + int(rng.integers(0, 10_000_000))
+        t_b = t + int(rng.integers(0, 30_000_000))
+        np.testing.assert_allclose(fast.thrust_time_s(t_a, t_b), ref.thrust_time_s(t_a, t_b),
+                                   rtol=EQUIVALENCE_RTOL, atol=0.0)
+        edge_t = t + int(rng.integers(-20_000_000, 20_000_000))
+        np.testing.assert_array_equal(fast.boundary_segments(edge_t, EDGE_GUARD_NS),
+                                      ref.boundary_segments(edge_t, EDGE_GUARD_NS))
+        samples = np.sort(rng.integers(t - 100_000_000, t + 25_000_000, 7))
+        for got, want in zip(fast.fraction_at(samples), ref.fraction_at(samples), strict=True):
+            np.testing.assert_allclose(got, want, rtol=EQUIVALENCE_RTOL, atol=0.0)
+    assert fast.fraction_at(np.array([], dtype=np.int64))[0].shape == (0, N_RANDOM)
