@@ -31,6 +31,17 @@ positive null vector of the 6×16 effectiveness matrix exists), and still do wit
 single thruster removed (checked in tests/flight_sw/test_fsw_layouts.py), which is what
 single-failure reconfiguration needs.
 
+``seed000_canted_16`` — the same four quads with every thruster canted by
+:data:`SEED000_CANT_DEG` about its quad's radial axis e_q: the axial thrusters lean
+towards the tangential direction and the tangential ones towards the axis, so each
+thruster's torque has components about all three body axes. That is what seed 004's
+underactuated control asks of three surviving thrusters (conditions (i)–(iii), in
+particular a torque about the spin axis of one sign from all three): no three thrusters of
+the conventional layout qualify, in any choice of spin axis (every torque there has a zero
+component), while this one has triples that do (flight_sw.control.underactuated.geometry;
+docs/reproductions.md, seed 004). The cant costs cos(10°), 1.5 %, of each thruster's
+authority along its old direction; the pairs of a quad still fire in opposite directions.
+
 ``seed001_table1_16`` — the 8 thrusters of seed 001 (MRP direct-parametric control with
 robust least-squares control allocation of a combined spacecraft), §5 Table 1, as 16
 unidirectional valves. Table 1 gives positions (arm R = 0.75 m, offset L = 0.75 m:
@@ -51,6 +62,8 @@ import math
 
 Vec3 = tuple[float, float, float]
 
+SEED000_CANT_DEG = 10.0
+"""``seed000_canted_16``: cant of each thruster about its quad's radial axis [deg]."""
 SEED001_UPPER_BOUND_N = 2.35
 """Seed 001 §5: upper bound ū of each actuator's force [N] (valve i)."""
 SEED001_LOWER_BOUND_N = 2.3
@@ -95,6 +108,21 @@ def seed000_conventional_16(arm_R_m: float, length_L_m: float) -> tuple[tuple[Ve
     return tuple(out)
 
 
+def seed000_canted_16(arm_R_m: float, length_L_m: float) -> tuple[tuple[Vec3, Vec3], ...]:
+    """``seed000_conventional_16`` with every direction turned by :data:`SEED000_CANT_DEG`
+    about its quad's radial axis (Rodrigues' rotation; see the module docstring)."""
+    c, s = math.cos(math.radians(SEED000_CANT_DEG)), math.sin(math.radians(SEED000_CANT_DEG))
+    out: list[tuple[Vec3, Vec3]] = []
+    for r, d in seed000_conventional_16(arm_R_m, length_L_m):
+        rho = math.hypot(r[1], r[2])
+        e = (0.0, r[1] / rho, r[2] / rho)  # the quad's radial unit vector
+        exd = (e[1] * d[2] - e[2] * d[1], e[2] * d[0] - e[0] * d[2], e[0] * d[1] - e[1] * d[0])
+        ed = e[0] * d[0] + e[1] * d[1] + e[2] * d[2]
+        turned = tuple(d[i] * c + exd[i] * s + e[i] * ed * (1.0 - c) for i in range(3))
+        out.append((r, (turned[0] or 0.0, turned[1] or 0.0, turned[2] or 0.0)))
+    return tuple(out)
+
+
 def seed001_table1_16(arm_R_m: float, length_L_m: float) -> tuple[tuple[Vec3, Vec3], ...]:
     """Geometry of seed 001's Table 1 as 16 valves (see module docstring; R = L = 0.75 m)."""
     R, L = arm_R_m, length_L_m
@@ -125,6 +153,7 @@ def seed001_table1_max_thrust_N(
 LAYOUTS = {
     "seed003_cascade_8": seed003_cascade_8,
     "seed000_conventional_16": seed000_conventional_16,
+    "seed000_canted_16": seed000_canted_16,
     "seed001_table1_16": seed001_table1_16,
 }
 

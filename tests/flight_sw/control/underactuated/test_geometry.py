@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections import Counter
+
 import numpy as np
 import pytest
 
@@ -17,6 +19,7 @@ from flight_sw.control.underactuated.geometry import (
 from tests.flight_sw.control.underactuated import ffrb_reference as ref
 
 TOL = 1e-12
+SEED000_NOMINAL_INERTIA = np.diag([18.0, 18.0, 24.0])  # fdir_16thr's [vehicle.nominal]
 
 
 def test_chosen_body_meets_every_condition() -> None:
@@ -96,6 +99,21 @@ def test_seed000_vehicle_has_no_qualifying_triple() -> None:
     b = effectiveness_matrix(np.array([g[0] for g in geo]), np.array([g[1] for g in geo]))
     good, bad = qualifying_triples(b, np.diag([18.0, 20.0, 24.0]), frames=CONTROL_FRAMES)
     assert good == [] and len(bad) == 560
+
+
+def test_canted_seed000_vehicle_has_qualifying_triples() -> None:
+    """Canted 10° about their quad radius, the CTC's thrusters give triples that qualify
+    with the spin axis along ±x or ±y; none along z, only because J_I = J_II there: with
+    J_II = 20 kg m², two triples qualify with axis III = +z."""
+    geo = LAYOUTS["seed000_canted_16"](0.5, 0.3)
+    b = effectiveness_matrix(np.array([g[0] for g in geo]), np.array([g[1] for g in geo]))
+    good, _ = qualifying_triples(b, SEED000_NOMINAL_INERTIA, frames=CONTROL_FRAMES)
+    assert Counter(g.frame for g in good) == {"III=+x": 8, "III=-x": 8, "III=+y": 2,
+                                              "III=-y": 2}
+    along_z, failing = qualifying_triples(b, SEED000_NOMINAL_INERTIA)
+    assert along_z == [] and all(not f.check.inertia_I_II_distinct for f in failing)
+    distinct, _ = qualifying_triples(b, np.diag([18.0, 20.0, 24.0]))
+    assert [g.check.thrusters for g in distinct] == [(1, 7, 10), (3, 8, 14)]
 
 
 def test_control_frames_are_rotations() -> None:
