@@ -154,9 +154,7 @@ class Encoder:
             raise IcdError(
                 f"alive counter {counter} of {name}: expected 0..{e2e.COUNTER_MODULUS - 1}"
             )
-        values: dict[str, Any] = {"CRC": 0, "AliveCounter": counter}
-        values.update(signals)
-        payload = layout.pack(values, signals)
+        payload = layout.pack_merged({"CRC": 0, "AliveCounter": counter}, signals)
         self._counters[name] = counter  # only once it is encoded: a bad value sends nothing
         return e2e.protect(did, payload, counter)
 

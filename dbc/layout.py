@@ -41,6 +41,7 @@ from cantools.database.utils import create_encode_decode_formats
 from dbc.errors import IcdError
 
 IDENTITY, LINEAR, OTHER = 0, 1, 2  # how a signal converts between raw and physical
+_MISSING = object()  # pack_merged: a signal the signals mapping does not have
 
 
 def _mode(signal: Any) -> int:
@@ -87,6 +88,20 @@ class FrameLayout:
              inf if s.maximum is None else float(s.maximum), s.conversion)
             for s in message.signals if _mode(s) == OTHER
         )
+        # The encoder's typed view of the integer fields (pack_merged), in signal order:
+        # range, and scale and offset as floats (identity: 1 and 0, exactly cantools'
+        # round(v) for any value below 2**53), or the conversion for the other kinds.
+        signals = message.signals
+        self._lo = [-inf if s.minimum is None else float(s.minimum) for s in signals]
+        self._hi = [inf if s.maximum is None else float(s.maximum) for s in signals]
+        self._scales = [float(s.conversion.scale) if _mode(s) != OTHER else 1.0
+                        for s in signals]
+        self._offsets = [float(s.conversion.offset) if _mode(s) != OTHER else 0.0
+                         for s in signals]
+        self._convs: list[Any] = [s.conversion for s in signals]
+        # cantools' own scale and offset objects (decoding returns its types)
+        self._dec_scales: list[Any] = [s.conversion.scale for s in signals]
+        self._dec_offsets: list[Any] = [s.conversion.offset for s in signals]
         # decoding: (name, mode, scale, offset, conversion)
         self._dec = tuple(
             (s.name, _mode(s), s.conversion.scale, s.conversion.offset, s.conversion)
@@ -142,6 +157,37 @@ class FrameLayout:
             raise self._error(values, source, exc) from None
         return bytearray(payload.to_bytes(self.length, "little"))
 
+    def pack_merged(self, base: Mapping[str, Any], signals: Mapping[str, Any]) -> bytearray:
+        """``pack({**base, **signals}, signals)`` without building the merged mapping: the
+        encoder's hot path (``base`` holds the E2E fields), on typed fields."""
+        if not self._fields:
+            merged = dict(base)
+            merged.update(signals)
+            return self.pack(merged, signals)
+        payload = 0
+        given = signals if isinstance(signals, dict) else dict(signals)
+        try:
+            for i in range(len(self._names)):
+                name = self._names[i]
+                x = given.get(name, _MISSING)
+                if x is _MISSING:
+                    x = base[name]
+                if self._modes[i] == OTHER:
+                    if not self._lo[i] <= x <= self._hi[i]:
+                        raise ValueError(name)
+                    raw = int(self._convs[i].numeric_scaled_to_raw(x))
+                else:
+                    v: float = x + 0.0  # a number, or a TypeError (quoted below)
+                    if not self._lo[i] <= v <= self._hi[i]:
+                        raise ValueError(name)
+                    raw = round((v - self._offsets[i]) / self._scales[i])
+                payload |= (raw & self._masks[i]) << self._shifts[i]
+        except Exception as exc:  # the slow path: say which value and why
+            merged = dict(base)
+            merged.update(signals)
+            raise self._error(merged, signals, exc) from None
+        return bytearray(payload.to_bytes(self.length, "little"))
+
     def _error(self, values: Mapping[str, Any], source: Mapping[str, Any] | None,
                exc: Exception) -> IcdError:
         """The IcdError for a ``pack`` that failed with ``exc``: the first bad signal."""
@@ -169,12 +215,13 @@ class FrameLayout:
         """``unpack`` for a message of little-endian integer fields only."""
         payload = int.from_bytes(data, "little")
         out: dict[str, Any] = {}
-        for i, (name, mode, scale, offset, conv) in enumerate(self._dec):
+        for i in range(len(self._names)):
             raw = (payload >> self._shifts[i]) & self._masks[i]
             sign = self._sign_bits[i]
             if raw & sign:
                 raw -= sign << 1
-            out[name] = _physical(raw, mode, scale, offset, conv)
+            out[self._names[i]] = _physical(raw, self._modes[i], self._dec_scales[i],
+                                            self._dec_offsets[i], self._convs[i])
         return out
 
 

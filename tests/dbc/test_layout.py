@@ -140,3 +140,29 @@ def test_big_endian_and_float_signals_equal_cantools() -> None:
         data = m.encode(values, scaling=True, strict=False)
         assert bytes(layout.pack(values)) == data
         assert layout.unpack(data) == m.decode(data, decode_choices=False, scaling=True)
+
+
+def test_pack_merged_equals_pack_of_the_merged_values(db: Database) -> None:
+    """The encoder's path (E2E fields apart from the signals) packs what pack packs, for
+    every message, a signal overriding a base field as a merged dict would."""
+    rng = random.Random(10)
+    for m in db.messages:
+        layout = FrameLayout(m)
+        for k in range(CASES_PER_MESSAGE // 10):
+            values = _random_values(m, rng, on_grid=k % 2 == 0)
+            base = {n: values.pop(n) for n in E2E_SIGNALS}
+            assert layout.pack_merged(base, values) == layout.pack({**base, **values})
+            assert layout.pack_merged({**base, "CRC": 1}, {**values, "CRC": 0}) == \
+                layout.pack({**base, **values, "CRC": 0})
+
+
+def test_encoder_names_a_bad_signal(db: Database) -> None:
+    """A bad value through the encoder's path raises IcdError naming signal and value."""
+    enc = Encoder(db)
+    good = {"Valid": 1, "RateX": 0.0, "RateY": 0.0, "RateZ": 0.0}
+    for bad, shown in ((1e9, repr(1e9)), (float("nan"), "nan"), ("fast", "'fast'"),
+                       (None, "None")):
+        with pytest.raises(IcdError, match=rf"IMU_RATE: RateX = {shown}"):
+            enc.encode("IMU_RATE", {**good, "RateX": bad})
+    with pytest.raises(IcdError, match=r"IMU_RATE: RateY = None"):
+        enc.encode("IMU_RATE", {"Valid": 1, "RateX": 0.0, "RateZ": 0.0})
