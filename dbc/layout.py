@@ -89,8 +89,9 @@ class FrameLayout:
             for s in message.signals if _mode(s) == OTHER
         )
         # The encoder's typed view of the integer fields (pack_merged), in signal order:
-        # range, and scale and offset as floats (identity: 1 and 0, exactly cantools'
-        # round(v) for any value below 2**53), or the conversion for the other kinds.
+        # range, and scale and offset as floats for Python numbers (identity: 1 and 0,
+        # exactly cantools' round(v) below 2**53; no signal of the DBC is that wide), or
+        # the conversion for the other kinds.
         signals = message.signals
         self._lo = [-inf if s.minimum is None else float(s.minimum) for s in signals]
         self._hi = [inf if s.maximum is None else float(s.maximum) for s in signals]
@@ -176,11 +177,15 @@ class FrameLayout:
                     if not self._lo[i] <= x <= self._hi[i]:
                         raise ValueError(name)
                     raw = int(self._convs[i].numeric_scaled_to_raw(x))
-                else:
-                    v: float = x + 0.0  # a number, or a TypeError (quoted below)
+                elif type(x) is float or type(x) is int or type(x) is bool:
+                    v: float = x + 0.0  # in C doubles: exactly pack's arithmetic for these
                     if not self._lo[i] <= v <= self._hi[i]:
                         raise ValueError(name)
                     raw = round((v - self._offsets[i]) / self._scales[i])
+                else:  # numpy scalars keep their own arithmetic (float32), as in pack
+                    if not self._lo[i] <= x <= self._hi[i]:
+                        raise ValueError(name)
+                    raw = round((x - self._dec_offsets[i]) / self._dec_scales[i])
                 payload |= (raw & self._masks[i]) << self._shifts[i]
         except Exception as exc:  # the slow path: say which value and why
             merged = dict(base)

@@ -29,13 +29,15 @@ finished segments in time order, and a query visits only those that reach its wi
 (from the newest back), so a cycle's queries cost a few segments each, not all of them
 (the FDIR runs every cycle of a 16-thruster vehicle: issue 23). The per-thruster sums
 add the segments in time order. ``tests/flight_sw/thrust_model_reference.py`` is the
-array form it is checked against.
+array form it is checked against, for queries within the horizon (beyond it each drops
+old segments its own way).
 
 Assumptions: the valve parameters are the vehicle's nominal ones (a valve that differs
 shows up as a residual, which is the point); the command delay is the same for every
 thruster (in lockstep it varies by ~0.4 ms with the frame order: the timing term of the
-residual's uncertainty covers it); segments that ended more than ``horizon_ns`` before
-the newest command are dropped.
+residual's uncertainty covers it); each thruster's segments that ended more than
+``horizon_ns`` before the newest command are dropped (a query reaching further back
+misses them).
 
 Source: first-order valve with transport delays, as the bench's valve model and e.g.
 Wertz & Larson (eds.) 1999, "Space Mission Analysis and Design", 3rd ed. (pulse-mode
@@ -177,6 +179,8 @@ class ThrustModel:
         for k in range(self.n):
             if stuck[k]:
                 out[k] = (t_b_ns - t_a_ns) * S_PER_NS
+                continue
+            if t_b_ns <= t_a_ns:  # an empty (or reversed) window holds no thrust
                 continue
             acc = 0.0
             for s, e, f0, tgt, tau in self._ending_after(k, t_a_ns):

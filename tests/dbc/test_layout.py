@@ -156,6 +156,27 @@ def test_pack_merged_equals_pack_of_the_merged_values(db: Database) -> None:
                 layout.pack({**base, **values, "CRC": 0})
 
 
+def test_pack_merged_keeps_numpy_scalar_arithmetic(db: Database) -> None:
+    """float32 values (rounded in float32 by pack, as cantools does) pack the same bytes
+    through the encoder's path, and refuse the same out-of-range value."""
+    sync = FrameLayout(db.get_message_by_name("SYNC"))
+    base = {"CRC": 0, "AliveCounter": 0}
+    for t in (2147483.8, 1234.5678, 0.1):
+        values = {"Cycle": 7, "SimTime": np.float32(t)}
+        assert sync.pack_merged(base, values) == sync.pack({**base, **values})
+    quat = FrameLayout(db.get_message_by_name("STR_QUAT"))
+    values = {"Valid": 1, "Largest": 0, "C0": np.float32(-0.7077888), "C1": 0.0, "C2": 0.0}
+    try:
+        expected: bytes | str = bytes(quat.pack({**base, **values}))
+    except IcdError as exc:
+        expected = str(exc)
+    try:
+        got: bytes | str = bytes(quat.pack_merged(base, values))
+    except IcdError as exc:
+        got = str(exc)
+    assert got == expected
+
+
 def test_encoder_names_a_bad_signal(db: Database) -> None:
     """A bad value through the encoder's path raises IcdError naming signal and value."""
     enc = Encoder(db)

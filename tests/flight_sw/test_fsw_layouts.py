@@ -21,7 +21,7 @@ UNIT_TOL = 1e-12
 POSITIVE_TOL = 1e-6
 RANK_RTOL = 1e-10
 LAYOUTS_16 = ("seed000_conventional_16", "seed000_canted_16")
-ARM_R_M, LENGTH_L_M = 0.5, 0.3
+ARM_R_M, LENGTH_L_M = 0.5, 0.1  # the seed-000 scenarios' dimensions
 
 
 def geometry(name: str) -> tuple[np.ndarray, np.ndarray]:

@@ -39,7 +39,7 @@ underactuated control asks of three surviving thrusters (conditions (i)–(iii),
 particular a torque about the spin axis of one sign from all three): no three thrusters of
 the conventional layout qualify, in any choice of spin axis (every torque there has a zero
 component), while this one has triples that do (flight_sw.control.underactuated.geometry;
-docs/reproductions.md, seed 004). The cant costs cos(10°), 1.5 %, of each thruster's
+docs/reproductions.md, seed 004). The cant costs 1 − cos 10° = 1.5 % of each thruster's
 authority along its old direction; the pairs of a quad still fire in opposite directions.
 
 ``seed001_table1_16`` — the 8 thrusters of seed 001 (MRP direct-parametric control with
