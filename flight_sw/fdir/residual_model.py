@@ -169,16 +169,24 @@ class ResidualModel:
         """Model quantities of the samples that have none yet (each computed once)."""
         model = self.thrust
         guard = round(2.0 * self.params.edge_uncertainty_s * NS_PER_S)
-        prev: _GyroSample | None = None
-        for g in self._gyro:
-            if g.cum_s is None:
-                if prev is None or prev.cum_s is None:
-                    g.cum_s = np.zeros(self.n)
-                else:
-                    g.cum_s = prev.cum_s + model.thrust_time_s(prev.t_ns, g.t_ns)
-                g.edges = model.boundary_segments(g.t_ns, guard)
+        gyro = self._gyro
+        i = len(gyro)  # the samples without them are the newest ones
+        while i > 0 and gyro[i - 1].cum_s is None:
+            i -= 1
+        prev = gyro[i - 1] if i > 0 else None
+        for j in range(i, len(gyro)):
+            g = gyro[j]
+            if prev is None or prev.cum_s is None:
+                g.cum_s = np.zeros(self.n)
+            else:
+                g.cum_s = prev.cum_s + model.thrust_time_s(prev.t_ns, g.t_ns)
+            g.edges = model.boundary_segments(g.t_ns, guard)
             prev = g
-        new = [a for a in self._accel if a.frac is None]
+        accel = self._accel
+        i = len(accel)
+        while i > 0 and accel[i - 1].frac is None:
+            i -= 1
+        new = [accel[j] for j in range(i, len(accel))]
         if new:
             frac, rate = model.fraction_at(np.array([a.t_ns for a in new], dtype=np.int64))
             for i, a in enumerate(new):
@@ -267,5 +275,7 @@ class ResidualModel:
             )
             z[3:6] = r_lin / sig_lin
             h_lin = self.lin / sig_lin[:, None]
-            self.pending_bias = (fs.mean(axis=0)) - f_pred.mean(axis=0)
+            # the means as numpy's mean takes them (add.reduce, then / count), less its
+            # overhead
+            self.pending_bias = fs.sum(axis=0) / s_count - f_pred.sum(axis=0) / s_count
         return Residual(t_a, t_b, span_s, z, tau_cmd_s, h_ang, h_lin, u_s, frac, w_lin, inv_var)

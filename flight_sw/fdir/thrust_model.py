@@ -108,7 +108,7 @@ class ThrustModel:
             return 0.0
         done = self._done[k]
         done.append((on, off, f0, 1.0, self._tau_r))
-        f_off = 1.0 + (f0 - 1.0) * math.exp(-(off - on) * S_PER_NS / self._tau_r)
+        f_off = self._f_off(k)
         done.append((off, until_ns, f_off, 0.0, self._tau_t))
         return f_off * math.exp(-(until_ns - off) * S_PER_NS / self._tau_t)
 
@@ -150,25 +150,19 @@ class ThrustModel:
             self._drive_off[k] = drive_off
             self._f_drive_on[k] = f0
 
-    def _current(self, k: int) -> list[Segment]:
-        """Thruster k's current drive interval and its open-ended tail (none if it never
-        fired)."""
-        on = self._drive_on[k]
-        if on == -INF_NS:
-            return []
-        off, f0 = self._drive_off[k], self._f_drive_on[k]
-        f_off = 1.0 + (f0 - 1.0) * math.exp(-(off - on) * S_PER_NS / self._tau_r)
-        return [(on, off, f0, 1.0, self._tau_r), (off, INF_NS, f_off, 0.0, self._tau_t)]
-
-    def _ending_after(self, k: int, t_ns: int) -> list[Segment]:
-        """Thruster k's segments that end after ``t_ns``, in time order, and the current
-        ones (whenever they end): the finished ones end in time order, so those that end
-        after ``t_ns`` are a tail of the list."""
+    def _first_ending_after(self, k: int, t_ns: int) -> int:
+        """Index of thruster k's first finished segment that ends after ``t_ns``: the
+        finished ones end in time order, so those are a tail of the list."""
         done = self._done[k]
         i = len(done)
         while i > 0 and done[i - 1][1] > t_ns:
             i -= 1
-        return done[i:] + self._current(k)
+        return i
+
+    def _f_off(self, k: int) -> float:
+        """Thruster k's thrust fraction where its current drive interval ends."""
+        on, off, f0 = self._drive_on[k], self._drive_off[k], self._f_drive_on[k]
+        return 1.0 + (f0 - 1.0) * math.exp(-(off - on) * S_PER_NS / self._tau_r)
 
     # --- queries ------------------------------------------------------------------------
 
@@ -182,18 +176,23 @@ class ThrustModel:
                 continue
             if t_b_ns <= t_a_ns:  # an empty (or reversed) window holds no thrust
                 continue
+            done = self._done[k]
             acc = 0.0
-            for s, e, f0, tgt, tau in self._ending_after(k, t_a_ns):
+            later = False  # a segment starts at or after t_b: so do all that follow
+            for j in range(self._first_ending_after(k, t_a_ns), len(done)):
+                s, e, f0, tgt, tau = done[j]
                 if s >= t_b_ns:
+                    later = True
                     break
-                if e <= t_a_ns:  # the current drive interval may have ended before t_a
-                    continue
-                u1 = s if s > t_a_ns else t_a_ns
-                u2 = e if e < t_b_ns else t_b_ns
-                x1 = (u1 - s) * S_PER_NS / tau
-                x2 = (u2 - s) * S_PER_NS / tau
-                acc += (tgt * (u2 - u1) * S_PER_NS
-                        + (f0 - tgt) * tau * (math.exp(-x1) - math.exp(-x2)))
+                acc += _integral(s, e, f0, tgt, tau, t_a_ns, t_b_ns)
+            on = self._drive_on[k]
+            if not later and on != -INF_NS and on < t_b_ns:  # the current drive interval
+                off, f0 = self._drive_off[k], self._f_drive_on[k]
+                if off > t_a_ns:  # it may have ended before t_a
+                    acc += _integral(on, off, f0, 1.0, self._tau_r, t_a_ns, t_b_ns)
+                if off < t_b_ns:  # and its tail, open-ended
+                    acc += _integral(off, INF_NS, self._f_off(k), 0.0, self._tau_t, t_a_ns,
+                                     t_b_ns)
             out[k] = acc
         return np.array(out)
 
@@ -206,10 +205,14 @@ class ThrustModel:
                 continue
             c = 0
             # a drive interval near t ends after t − guard (edges near t, or t inside it)
-            for s, e, _f0, tgt, _tau in self._ending_after(k, t_ns - guard_ns):
-                if tgt > 0.0 and (abs(s - t_ns) < guard_ns or abs(e - t_ns) < guard_ns
-                                  or (s < t_ns < e and e - s < 2 * guard_ns)):
+            done = self._done[k]
+            for j in range(self._first_ending_after(k, t_ns - guard_ns), len(done)):
+                s, e, _f0, tgt, _tau = done[j]
+                if tgt > 0.0 and _near(s, e, t_ns, guard_ns):
                     c += 1
+            on = self._drive_on[k]  # the current drive interval (its tail drives nothing)
+            if on != -INF_NS and _near(on, self._drive_off[k], t_ns, guard_ns):
+                c += 1
             count[k] = float(c)
         return np.array(count)
 
@@ -222,19 +225,55 @@ class ThrustModel:
         stuck: list[bool] = self.stuck_open.tolist()
         frac = [[0.0] * n for _ in ts]
         rate = [[0.0] * n for _ in ts]
-        first = min(ts)
         for k in range(n):
             if stuck[k]:
                 for row in frac:
                     row[k] = 1.0
                 continue
-            segs = self._ending_after(k, first)
+            done = self._done[k]
+            on = self._drive_on[k]
             for m in range(len(ts)):
                 t = ts[m]
-                for s, e, f0, tgt, tau in segs:
-                    if s <= t < e:  # the one segment holding t (they do not overlap)
-                        f = tgt + (f0 - tgt) * math.exp(-((t - s) * S_PER_NS / tau))
-                        frac[m][k] = f
-                        rate[m][k] = abs(tgt - f) / tau
+                # the one segment holding t (they follow each other without overlap): the
+                # current drive interval or its tail, else the last finished one starting
+                # at or before t
+                if on != -INF_NS and t >= on:
+                    off = self._drive_off[k]
+                    if t < off:
+                        f = _value(on, self._f_drive_on[k], 1.0, self._tau_r, t)
+                        frac[m][k], rate[m][k] = f, abs(1.0 - f) / self._tau_r
+                    else:
+                        f = _value(off, self._f_off(k), 0.0, self._tau_t, t)
+                        frac[m][k], rate[m][k] = f, abs(0.0 - f) / self._tau_t
+                    continue
+                for j in range(len(done) - 1, -1, -1):
+                    s, e, f0, tgt, tau = done[j]
+                    if s <= t:
+                        if t < e:
+                            f = _value(s, f0, tgt, tau, t)
+                            frac[m][k], rate[m][k] = f, abs(tgt - f) / tau
                         break
         return np.array(frac), np.array(rate)
+
+
+def _integral(s: int, e: int, f0: float, tgt: float, tau: float, t_a_ns: int,
+              t_b_ns: int) -> float:
+    """∫ F/T_max over the part of segment (s, e, F0, target, τ) inside [t_a, t_b] [s]
+    (module docstring; the segment must overlap the window)."""
+    u1 = s if s > t_a_ns else t_a_ns
+    u2 = e if e < t_b_ns else t_b_ns
+    x1 = (u1 - s) * S_PER_NS / tau
+    x2 = (u2 - s) * S_PER_NS / tau
+    return tgt * (u2 - u1) * S_PER_NS + (f0 - tgt) * tau * (math.exp(-x1) - math.exp(-x2))
+
+
+def _value(s: int, f0: float, tgt: float, tau: float, t_ns: int) -> float:
+    """F/T_max at ``t_ns`` on the segment starting at ``s`` (module docstring)."""
+    return tgt + (f0 - tgt) * math.exp(-((t_ns - s) * S_PER_NS / tau))
+
+
+def _near(s: int, e: int, t_ns: int, guard_ns: int) -> bool:
+    """Has the drive interval [s, e) an edge within ``guard_ns`` of ``t_ns``, or is it
+    shorter than two guards with ``t_ns`` inside?"""
+    return (abs(s - t_ns) < guard_ns or abs(e - t_ns) < guard_ns
+            or (s < t_ns < e and e - s < 2 * guard_ns))
