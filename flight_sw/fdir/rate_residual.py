@@ -143,6 +143,7 @@ class RateResidualFdir(ThrusterFdirStrategy):
     ) -> None:
         self._res = ResidualModel(effectiveness, inertia_B_kgm2, mass_kg, max_thrust_N, min_on_s,
                                   control_period_ns, imu_period_ns, params)
+        self._lin_sq = self._res.lin**2  # (3, n), a constant of the vehicle
         self.params = params
         self.n = self._res.n
         self._period_ns = control_period_ns
@@ -209,11 +210,14 @@ class RateResidualFdir(ThrusterFdirStrategy):
         """
         p = self.params
         n = self.n
-        frac_cmd = res.frac.copy()
-        frac_cmd[:, self._res.thrust.stuck_open] = 0.0
+        stuck = self._res.thrust.stuck_open
+        frac_cmd = res.frac
+        if stuck.any():
+            frac_cmd = res.frac.copy()
+            frac_cmd[:, stuck] = 0.0
         lin = self._res.lin
         wl = res.w_lin @ lin  # (samples, n): Σ_axis r/σ² · lin_i
-        ivl = res.inv_var @ (lin**2)  # (samples, n): Σ_axis lin_i²/σ²
+        ivl = res.inv_var @ self._lin_sq  # (samples, n): Σ_axis lin_i²/σ²
         g_ang_c = -res.h_ang * res.tau_cmd_s  # (3, n)
         g_ang_o = res.h_ang * np.maximum(res.span_s - res.tau_cmd_s, 0.0)
         z_ang = res.z[0:3]
@@ -230,8 +234,9 @@ class RateResidualFdir(ThrusterFdirStrategy):
             )
         )
         beta_max = 1.0 + p.thrust_rel_error + p.model_rel_error
-        with np.errstate(divide="ignore", invalid="ignore"):
-            beta = np.clip(np.where(hh > 0.0, hz / hh, 0.0), 0.0, beta_max)
+        # hz/hh where hh > 0, else 0, clipped to [0, β_max] (np.clip's result, cheaper)
+        beta = np.minimum(np.maximum(np.divide(hz, hh, out=np.zeros_like(hz), where=hh > 0.0),
+                                     0.0), beta_max)
         gain = 2.0 * beta * hz - beta**2 * hh
         known = np.concatenate((self._known, self._known))
         gain[known] = -np.inf

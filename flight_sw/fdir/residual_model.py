@@ -74,6 +74,7 @@ class _AccelSample:
     f: np.ndarray
     frac: np.ndarray | None = None
     rate: np.ndarray | None = None
+    row: np.ndarray | None = None  # f, frac and rate in one row (one stacking per window)
 
 
 @dataclass(frozen=True)
@@ -191,6 +192,7 @@ class ResidualModel:
             frac, rate = model.fraction_at(np.array([a.t_ns for a in new], dtype=np.int64))
             for i, a in enumerate(new):
                 a.frac, a.rate = frac[i], rate[i]
+                a.row = np.concatenate((a.f, frac[i], rate[i]))
 
     def _window(self, t_ns: int) -> tuple[_GyroSample, _GyroSample] | None:
         """The gyro samples opening and closing the window (the newest one closes it)."""
@@ -249,9 +251,10 @@ class ResidualModel:
         h_lin = np.zeros((3, n))
         u_s = np.zeros(n)
         if s_count:
-            fs = np.array([a.f for a in acc])
-            frac = np.array([a.frac for a in acc])
-            rate = np.array([a.rate for a in acc])
+            rows = np.array([a.row for a in acc])  # (samples, 3 + 2n), then each part
+            fs = np.ascontiguousarray(rows[:, :3])  # contiguous: the products below as
+            frac = np.ascontiguousarray(rows[:, 3 : 3 + n])  # on separately stacked arrays
+            rate = np.ascontiguousarray(rows[:, 3 + n :])
             dt = self.imu_period_s
             f_pred = frac @ self.lin.T  # (samples, 3)
             r_s = (fs - self.bias) - f_pred
