@@ -389,15 +389,18 @@ class ThrusterSet:
     @property
     def propellant_kg(self) -> tuple[float, ...]:
         """Propellant used per thruster so far, impulse / (Isp · g0) [kg]."""
+        return tuple(self._propellant_list())
+
+    def _propellant_list(self) -> list[float]:
+        """:attr:`propellant_kg` as a list, by index (telemetry reads it every 10 ms)."""
         g0 = self.g0_m_s2
-        return tuple(
-            i / (v.params.isp_s * g0) for i, v in zip(self._impulse_Ns, self.valves, strict=True)
-        )
+        valves, impulse = self.valves, self._impulse_Ns
+        return [impulse[k] / (valves[k].params.isp_s * g0) for k in range(len(valves))]
 
     @property
     def total_propellant_kg(self) -> float:
         """Propellant used by all thrusters so far [kg]."""
-        return math.fsum(self.propellant_kg)
+        return math.fsum(self._propellant_list())
 
     @property
     def openings(self) -> tuple[int, ...]:
