@@ -21,6 +21,15 @@ change in the machine's load spreads over all of them; then the quickstart comma
   (``python -m flight_sw --check``: interpreter, imports and design-time set-up) and the
   plots (the median difference of the two commands).
 
+Two builds (``--baseline PYTHON``): the interpreter of another install of thruster-hil
+(a virtual environment with an earlier commit installed, ``pip install <checkout>``) runs
+each scenario too, taking turns with this one (run 1 here, run 1 there, ...: the machine's
+load falls on both alike), and the JSON gains ``baseline``: its figures per scenario and
+``ratios``, per scenario the medians of the paired ratios this build / the baseline of the
+real-time factor and of the flight software's cycle p50 and p99. Every run of a comparison
+starts in the scratch folder, so each interpreter imports its own install, never the
+checkout's sources.
+
 Bytecode: an installed package has its modules compiled (pip writes the ``.pyc`` files at
 install; an editable checkout gets them on its first run), but a shell with
 ``PYTHONDONTWRITEBYTECODE`` set never writes them, and then every command compiles ~100
@@ -34,6 +43,7 @@ runs made together. ``wall`` clock reads here are the benchmark's own.
 
     python benchmarks/lockstep_speed.py                  # 3 runs, every shipped scenario
     python benchmarks/lockstep_speed.py --runs 5 --scenarios quickstart fdir_16thr
+    python benchmarks/lockstep_speed.py --runs 5 --no-command --baseline ../old-venv/bin/python
 """
 
 from __future__ import annotations
@@ -41,6 +51,7 @@ from __future__ import annotations
 import argparse
 import compileall
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -67,20 +78,23 @@ VARIANTS: dict[str, tuple[tuple[str, ...], dict[str, str]]] = {
 }
 
 
-def _timed(argv: list[str], env: dict[str, str]) -> float:
+def _timed(argv: list[str], env: dict[str, str], cwd: Path = REPO) -> float:
     """Wall time [s] of one command, start to exit (its output discarded)."""
     t0 = time.perf_counter_ns()
-    subprocess.run(argv, cwd=REPO, env=env, capture_output=True, check=False)
+    subprocess.run(argv, cwd=cwd, env=env, capture_output=True, check=False)
     return (time.perf_counter_ns() - t0) / NS_PER_S
 
 
-def _run(scenario: Path, scratch: Path, env: dict[str, str],
-         extra: tuple[str, ...] = ()) -> tuple[float, dict[str, Any]]:
+def _run(scenario: Path, scratch: Path, env: dict[str, str], extra: tuple[str, ...] = (),
+         python: str | None = None) -> tuple[float, dict[str, Any]]:
     """One ``thruster-hil run`` as a user types it: no ``--bus``, so a channel of its own
     (a named bus would add the 0.25 s listen for another run); its wall time [s] and its
-    summary."""
+    summary. ``python``: another install's interpreter (started in ``scratch``, so it
+    imports that install; module docstring)."""
     out = scratch / f"{scenario.stem}-{uuid.uuid4().hex[:8]}"
-    wall_s = _timed([*CONSOLE, "run", str(scenario), "--out", str(out), *extra], env)
+    console = CONSOLE if python is None else (python, *CONSOLE[1:])
+    wall_s = _timed([*console, "run", str(scenario), "--out", str(out), *extra], env,
+                    REPO if python is None else scratch)
     summary: dict[str, Any] = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     return wall_s, summary
 
@@ -110,6 +124,30 @@ def _scenario_figures(summaries: list[dict[str, Any]]) -> dict[str, Any]:
                          if any(k in f for f in fsw)},
         "passed": [s["passed"] for s in summaries],
     }
+
+
+def _ratios(new: list[dict[str, Any]], old: list[dict[str, Any]]) -> dict[str, float]:
+    """Medians of the paired ratios this build / the baseline (runs taken in turn)."""
+    def fsw(s: dict[str, Any], key: str) -> float:
+        return float((s["fsw"].get("cycle_time_us") or {}).get(key, math.nan))
+
+    pairs = list(zip(new, old, strict=True))
+    return {"realtime_factor": _median([n["realtime_factor"] / o["realtime_factor"]
+                                        for n, o in pairs]),
+            "fsw_cycle_p50": _median([fsw(n, "p50") / fsw(o, "p50") for n, o in pairs]),
+            "fsw_cycle_p99": _median([fsw(n, "p99") / fsw(o, "p99") for n, o in pairs])}
+
+
+def _check_baseline(python: str, scratch: Path) -> str | None:
+    """Why ``python`` cannot serve as a baseline (None if it can)."""
+    try:
+        done = subprocess.run([python, "-c", "import bench.operator.entry"], cwd=scratch,
+                              capture_output=True, text=True, check=False)
+    except OSError as exc:
+        return f"cannot start it ({exc.strerror or exc})"
+    if done.returncode != 0:
+        return "it has no thruster-hil installed (import bench.operator.entry failed)"
+    return None
 
 
 def _command_figures(runs: int, scratch: Path, env: dict[str, str]) -> dict[str, Any]:
@@ -150,6 +188,9 @@ def main() -> None:
     p.add_argument("--scenarios", nargs="*", default=None,
                    help="scenario names in scenarios/ (default: every shipped one)")
     p.add_argument("--no-command", action="store_true", help="skip the command timing")
+    p.add_argument("--baseline", metavar="PYTHON", default=None,
+                   help="another install's interpreter: its runs take turns with these, "
+                        "and the JSON compares the two (module docstring)")
     p.add_argument("--bytecode", choices=("cached", "source"), default="cached",
                    help="cached: compile the project's modules first, as an install has them "
                         "(default); source: leave the checkout as it is")
@@ -166,10 +207,18 @@ def main() -> None:
             compileall.compile_dir(REPO / pkg, quiet=1)
     with tempfile.TemporaryDirectory(prefix="thil-speed-") as tmp:
         scratch = Path(tmp)
+        if args.baseline is not None and (why := _check_baseline(args.baseline, scratch)):
+            p.error(f"--baseline {args.baseline}: {why}")
         per: dict[str, list[dict[str, Any]]] = {n: [] for n in names}
+        base: dict[str, list[dict[str, Any]]] = {n: [] for n in names}
         for _ in range(args.runs):
             for n in names:
-                per[n].append(_run(SCENARIOS / f"{n}.toml", scratch, env, ("--no-plots",))[1])
+                scenario = SCENARIOS / f"{n}.toml"
+                if args.baseline is None:
+                    per[n].append(_run(scenario, scratch, env, ("--no-plots",))[1])
+                    continue
+                per[n].append(_run(scenario, scratch, env, ("--no-plots",), sys.executable)[1])
+                base[n].append(_run(scenario, scratch, env, ("--no-plots",), args.baseline)[1])
         result: dict[str, Any] = {
             "benchmark": "lockstep_speed",
             "cpus": os.cpu_count(),
@@ -177,6 +226,12 @@ def main() -> None:
             "load_avg_1min": os.getloadavg()[0],
             "scenarios": {n: _scenario_figures(s) for n, s in per.items()},
         }
+        if args.baseline is not None:
+            result["baseline"] = {
+                "python": args.baseline,
+                "scenarios": {n: _scenario_figures(s) for n, s in base.items()},
+                "ratios": {n: _ratios(per[n], base[n]) for n in names},
+            }
         if not args.no_command:
             result["command"] = _command_figures(args.runs, scratch, env)
     print(json.dumps(result, indent=2))

@@ -47,3 +47,32 @@ def test_unknown_scenario_is_refused_by_name() -> None:
     done = subprocess.run([sys.executable, str(SCRIPT), "--scenarios", "nope"], cwd=REPO,
                           capture_output=True, text=True, timeout=TIMEOUT_S)
     assert done.returncode == 2 and "scenarios/nope.toml" in done.stderr
+
+
+def test_baseline_runs_take_turns_and_give_paired_ratios() -> None:
+    """--baseline: the other install's figures and the paired ratios per scenario (here the
+    same install against itself: each ratio a positive finite number)."""
+    done = subprocess.run([sys.executable, str(SCRIPT), "--runs", "1", "--scenarios",
+                           "quickstart", "--no-command", "--baseline", sys.executable],
+                          cwd=REPO, capture_output=True, text=True, timeout=TIMEOUT_S)
+    assert done.returncode == 0, done.stderr[-3000:]
+    r = json.loads(done.stdout)
+    b = r["baseline"]
+    assert b["python"] == sys.executable and b["scenarios"]["quickstart"]["runs"] == 1
+    ratios = b["ratios"]["quickstart"]
+    assert set(ratios) == {"realtime_factor", "fsw_cycle_p50", "fsw_cycle_p99"}
+    assert all(math.isfinite(v) and v > 0.0 for v in ratios.values())
+    assert "command" not in r
+
+
+def test_a_baseline_without_the_project_is_refused_by_name(tmp_path: Path) -> None:
+    """--baseline naming an interpreter that cannot import thruster-hil: exit 2, named."""
+    venv = tmp_path / "bare"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True,
+                   timeout=TIMEOUT_S)
+    bare = str(venv / "bin" / "python")
+    done = subprocess.run([sys.executable, str(SCRIPT), "--scenarios", "quickstart",
+                           "--baseline", bare], cwd=REPO, capture_output=True, text=True,
+                          timeout=TIMEOUT_S)
+    assert done.returncode == 2
+    assert f"--baseline {bare}" in done.stderr and "no thruster-hil installed" in done.stderr
