@@ -146,7 +146,7 @@ def qualifying_triples(effectiveness: np.ndarray, inertia_B_kgm2: np.ndarray,
     ok = np.ones(n, dtype=bool) if mask is None else np.asarray(mask, dtype=bool)
     if ok.shape != (n,):
         raise ConfigError(_SOURCE, "mask", ok.shape, f"{n} flags")
-    j = _principal_diag(inertia_B_kgm2)
+    j = principal_diag(inertia_B_kgm2)
     good: list[FrameCheck] = []
     bad: list[FrameCheck] = []
     for idx in itertools.combinations(np.flatnonzero(ok).tolist(), 3):
@@ -165,7 +165,8 @@ def qualifying_triples(effectiveness: np.ndarray, inertia_B_kgm2: np.ndarray,
     return good, bad
 
 
-def _principal_diag(inertia_B_kgm2: np.ndarray) -> np.ndarray:
+def principal_diag(inertia_B_kgm2: np.ndarray) -> np.ndarray:
+    """The diagonal (J_x, J_y, J_z) of a diagonal inertia [kg m²]; ConfigError otherwise."""
     j = np.asarray(inertia_B_kgm2, dtype=float)
     if j.shape != (3, 3):
         raise ConfigError(_SOURCE, "inertia_B_kgm2", j.shape, "a 3×3 matrix")
