@@ -115,7 +115,7 @@ class FrameLayout:
         ``source``: what to quote in an error (default ``values``).
         """
         if self._fields:
-            return self._pack_fields(values, source)
+            return self._pack_fields({}, values, source)
         raw: dict[str, int | float] = {}
         try:
             for name, lo, hi, scale, offset, to_int in self._enc:
@@ -136,28 +136,6 @@ class FrameLayout:
             raise self._error(values, source, exc) from None
         return bytearray(packed.to_bytes(self.length, "big"))
 
-    def _pack_fields(self, values: Mapping[str, Any], source: Mapping[str, Any] | None
-                     ) -> bytearray:
-        """``pack`` for a message of little-endian integer fields only."""
-        raw: dict[str, int] = {}
-        try:
-            for name, lo, hi, scale, offset, _to_int in self._enc:
-                v = values[name]
-                if not lo <= v <= hi:
-                    raise ValueError(name)
-                raw[name] = round((v - offset) / scale)
-            for name, lo, hi, conv in self._enc_other:
-                v = values[name]
-                if not lo <= v <= hi:
-                    raise ValueError(name)
-                raw[name] = int(conv.numeric_scaled_to_raw(v))
-            payload = 0
-            for i, name in enumerate(self._names):
-                payload |= (raw[name] & self._masks[i]) << self._shifts[i]
-        except Exception as exc:  # the slow path: say which value and why
-            raise self._error(values, source, exc) from None
-        return bytearray(payload.to_bytes(self.length, "little"))
-
     def pack_merged(self, base: Mapping[str, Any], signals: Mapping[str, Any]) -> bytearray:
         """``pack({**base, **signals}, signals)`` without building the merged mapping: the
         encoder's hot path (``base`` holds the E2E fields), on typed fields."""
@@ -165,6 +143,12 @@ class FrameLayout:
             merged = dict(base)
             merged.update(signals)
             return self.pack(merged, signals)
+        return self._pack_fields(base, signals, signals)
+
+    def _pack_fields(self, base: Mapping[str, Any], signals: Mapping[str, Any],
+                     source: Mapping[str, Any] | None) -> bytearray:
+        """``pack`` of ``{**base, **signals}`` for a message of little-endian integer fields
+        only, on typed fields (``source``: what an error quotes)."""
         payload = 0
         given = signals if isinstance(signals, dict) else dict(signals)
         try:
@@ -190,7 +174,7 @@ class FrameLayout:
         except Exception as exc:  # the slow path: say which value and why
             merged = dict(base)
             merged.update(signals)
-            raise self._error(merged, signals, exc) from None
+            raise self._error(merged, source, exc) from None
         return bytearray(payload.to_bytes(self.length, "little"))
 
     def _error(self, values: Mapping[str, Any], source: Mapping[str, Any] | None,

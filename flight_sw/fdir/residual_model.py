@@ -72,9 +72,7 @@ class _AccelSample:
 
     t_ns: int
     f: np.ndarray
-    frac: np.ndarray | None = None
-    rate: np.ndarray | None = None
-    row: np.ndarray | None = None  # f, frac and rate in one row (one stacking per window)
+    row: np.ndarray | None = None  # f, thrust fraction and its rate, one row (one stacking)
 
 
 @dataclass(frozen=True)
@@ -185,13 +183,12 @@ class ResidualModel:
             prev = g
         accel = self._accel
         i = len(accel)
-        while i > 0 and accel[i - 1].frac is None:
+        while i > 0 and accel[i - 1].row is None:
             i -= 1
         new = [accel[j] for j in range(i, len(accel))]
         if new:
             frac, rate = model.fraction_at(np.array([a.t_ns for a in new], dtype=np.int64))
             for i, a in enumerate(new):
-                a.frac, a.rate = frac[i], rate[i]
                 a.row = np.concatenate((a.f, frac[i], rate[i]))
 
     def _window(self, t_ns: int) -> tuple[_GyroSample, _GyroSample] | None:

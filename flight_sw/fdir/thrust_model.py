@@ -115,7 +115,7 @@ class ThrustModel:
     def command(self, t_ns: int, on_time_s: np.ndarray) -> None:
         """The on-times [s] commanded for the period starting at ``t_ns``."""
         t_rx = t_ns + self._delay_ns
-        d: list[float] = [float(x) for x in np.asarray(on_time_s, dtype=float)[: self.n].tolist()]
+        d: list[float] = np.asarray(on_time_s, dtype=float)[: self.n].tolist()
         for k in range(len(d)):
             if d[k] > 0.0:
                 self._fire(k, t_rx, round(d[k] * NS_PER_S))
