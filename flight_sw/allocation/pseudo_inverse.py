@@ -23,12 +23,23 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
    a. if the demand is *attainable* — inside the attainable set
       ``A = {B T : 0 ≤ T_i ≤ T_max,i} = Σ_j [0, T_max,j] g_j`` (``g_j`` the columns of
       ``B``), a zonotope — and ``exact_repair`` is on, solve the bounded least-squares
-      problem ``min ‖B T − d‖, 0 ≤ T ≤ T_max`` as the box QP ``M = BᵀB``, ``c = Bᵀd`` of
-      :func:`flight_sw.allocation.active_set.box_qp` (the exact active-set solver the QP
-      allocators use; least-norm on its free set), which then has a zero residual: an
-      attainable demand is always reproduced exactly. The test is one small
-      matrix-vector product against the facet inequalities ``n·x ≤ h(n)``
-      precomputed at construction: a facet normal ``n`` is orthogonal to r − 1
+      problem ``min ‖B T − d‖, 0 ≤ T ≤ T_max`` as the box QP ``M = BᵀB + εI``,
+      ``c = Bᵀd`` of :func:`flight_sw.allocation.active_set.box_qp` (the exact active-set
+      solver the QP allocators use), which then has a zero residual: an attainable demand
+      is always reproduced exactly. The ridge ``ε`` (:data:`LEAST_NORM_RIDGE_RTOL` × the
+      mean diagonal of ``BᵀB``) picks the least-norm thrusts among the many that reproduce
+      the demand (as ε → 0 the regularised minimiser tends to the least-norm point of the
+      solution set: the Tikhonov limit) and makes ``M`` definite, so the solver's
+      primal-dual rounds settle on Cholesky solves; a least-norm solve on the active set
+      they find then removes the ridge's bias (ε → 0,
+      :func:`flight_sw.allocation.active_set.refine`, as the QP allocators do). Without
+      the ridge (``M`` only semi-definite: rank m < n) the rounds cycled in 295 of the 310
+      repairs of a replay of the quickstart's cycles, the primal active-set method
+      finished from wherever they stopped (~0.6 ms a call, against ~20 µs now) and the
+      answer depended on that path: a minimiser, but not the least-norm one (up to 0.9 N
+      larger in norm; tests/ compare with OSQP's least-norm answer). The attainability
+      test is one small matrix-vector product against the facet inequalities
+      ``n·x ≤ h(n)`` precomputed at construction: a facet normal ``n`` is orthogonal to r − 1
       independent generators (the bounds scale the generators, not their directions,
       so the normals are those of ``B``), with support ``h(n) = Σ_j T_max,j max(n·g_j, 0)``
       (Durham 1994 for equal bounds; the per-generator weight is each segment's length);
@@ -91,10 +102,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc import validation as check
-from flight_sw.allocation.active_set import FREE, box_qp
+from flight_sw.allocation.active_set import FREE, box_qp, refine
 from flight_sw.allocation.base import RANK_RTOL, BoundSpec, ControlAllocation
 from flight_sw.allocation.linear_program import solve_lp
 
+# The bounded least squares' ridge ε relative to the mean diagonal of BᵀB (step 3a, the
+# fallback): small enough to leave the residual at round-off (< 1e-13 in the objective on
+# the quickstart's repairs), large enough for Cholesky pivots far above PD_PIVOT_RTOL.
+LEAST_NORM_RIDGE_RTOL = 1e-9
 # Smallest component (of a unit-sum null vector) accepted as "strictly positive".
 NULL_VECTOR_MIN_COMPONENT = 1e-9
 # Per thruster number, the extra cost that breaks ties between null rays of equal fuel.
@@ -218,8 +233,12 @@ class PseudoInverseAllocator(ControlAllocation):
         # inequalities mapped to demand space, ``normals·U_rᵀ d ≤ h + tol``.
         self._neg_inv_v = None if self._null_v is None else -1.0 / self._null_v
         self._overflow_N = u_a * (1.0 + THRUST_RTOL)
-        # BᵀB of the bounded least squares (array and lists, as the QP allocators keep M)
-        self._m_mat = b_a.T @ b_a
+        # BᵀB + εI of the bounded least squares (array and lists, as the QP allocators keep
+        # M): the ridge makes the answer the least-norm one and M definite (docstring, 3a)
+        gram = b_a.T @ b_a
+        ridge = LEAST_NORM_RIDGE_RTOL * float(np.mean(np.diag(gram))) if gram.size else 0.0
+        self._m_mat = gram + ridge * np.eye(gram.shape[0])
+        self._definite = ridge > 0.0
         self._m_list = self._m_mat.tolist()
         self._free = np.full(u_a.size, FREE, dtype=np.int8)
         self._halfspaces: tuple[np.ndarray, np.ndarray] | None = None
@@ -253,10 +272,12 @@ class PseudoInverseAllocator(ControlAllocation):
         return bool((normals_d @ d <= h_tol).all())
 
     def _bounded_lsq(self, d: np.ndarray) -> np.ndarray:
-        """``argmin ‖B T − d‖²`` over ``0 ≤ T ≤ T_max`` (least-norm where not unique)."""
+        """``argmin ‖B T − d‖²`` over ``0 ≤ T ≤ T_max`` (least-norm where not unique: the
+        ridge of ``M``)."""
         x, _ = box_qp(self._m_mat, self._b_a.T @ d, self._lo_a, self._hi_a, self._free,
-                      False, self._m_list)
-        return x
+                      self._definite, self._m_list)
+        # ε → 0 on the ridge's active set: exact (the ridge leaves ~1e-8 of residual)
+        return refine(self._b_a, d, x, self._lo_a, self._hi_a, self._attained_tol**2)
 
     def _in_range_residual(self, d: np.ndarray, t_a: np.ndarray) -> float:
         return float(np.linalg.norm(self._range_T @ (d - self._b_a @ t_a)))

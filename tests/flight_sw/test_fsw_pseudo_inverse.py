@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import osqp
 import pytest
+import scipy.sparse as sp
 from scipy.optimize import lsq_linear
 
 from dbc.errors import ConfigError
@@ -20,6 +22,12 @@ LSQ_MATCH_TOL = 1e-9  # fallback result vs a direct scipy bounded least squares
 # worst peak of the shifted pseudo-inverse over vertex demands B·{0,1}^8 (torque, wrench)
 SEED003_SHIFT_OVERFLOW_BOUND = {"torque": 1.5, "wrench": 1.875}
 INFEASIBLE_SCALE = 50.0  # demands this many times the largest single-thruster effect
+# The repair's thrusts vs the least-norm exact ones from OSQP (polished, tolerances far
+# below this).
+LEAST_NORM_TOL_N = 1e-6
+OSQP_EPS = 1e-12
+OSQP_MAX_ITER = 100_000
+N_LEAST_NORM = 40  # repaired demands checked against OSQP
 
 
 def matrix(layout: tuple[np.ndarray, np.ndarray], rows: str) -> np.ndarray:
@@ -73,6 +81,44 @@ def test_known_counterexample_needs_the_repair(
     np.testing.assert_allclose(res_plain.achieved, demand / 1.25, atol=FEASIBLE_RESIDUAL_TOL)
     res = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n)).allocate(demand)
     assert res.residual_norm <= FEASIBLE_RESIDUAL_TOL and not res.saturated
+
+
+def _least_norm_reference(b: np.ndarray, demand: np.ndarray, tmax: float) -> np.ndarray:
+    """min ½‖T‖² subject to B T = d and 0 ≤ T ≤ T_max, by OSQP at tight tolerances with
+    its polish step (the independent reference: B may have dependent rows)."""
+    n = b.shape[1]
+    a = sp.vstack([sp.csc_matrix(b), sp.identity(n)], format="csc")
+    solver = osqp.OSQP()
+    solver.setup(sp.identity(n, format="csc"), np.zeros(n), a,
+                 np.concatenate([demand, np.zeros(n)]), np.concatenate([demand, np.full(n, tmax)]),
+                 eps_abs=OSQP_EPS, eps_rel=OSQP_EPS, max_iter=OSQP_MAX_ITER, polishing=True,
+                 verbose=False)
+    res = solver.solve(raise_error=False)
+    assert res.info.status_val == osqp.SolverStatus.OSQP_SOLVED, res.info.status
+    return np.asarray(res.x)
+
+
+@pytest.mark.parametrize("rows", ["torque", "wrench"])
+def test_repair_gives_the_least_norm_exact_thrusts(
+    layout: tuple[np.ndarray, np.ndarray], rows: str, max_thrust_n: float, rng: np.random.Generator
+) -> None:
+    """Overflowing attainable demands: the repair's thrusts are the least-norm exact ones."""
+    b = matrix(layout, rows)
+    alloc = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n))
+    plain = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n, exact_repair=False))
+    checked = 0
+    # thrusts clipped from a wider range: about a third at each bound, a third inside
+    for t_true in np.clip(rng.uniform(-0.5, 1.5, (N_RANDOM, 8)), 0.0, 1.0) * max_thrust_n:
+        demand = b @ t_true
+        if not plain.allocate(demand).saturated:
+            continue  # not a repair: steps 1-2 alone
+        res = alloc.allocate(demand)
+        ref = _least_norm_reference(b, demand, max_thrust_n)
+        np.testing.assert_allclose(res.thrust_N, ref, atol=LEAST_NORM_TOL_N)
+        checked += 1
+        if checked == N_LEAST_NORM:
+            break
+    assert checked > 0
 
 
 @pytest.mark.parametrize("rows", ["torque", "wrench"])
