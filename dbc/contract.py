@@ -45,7 +45,8 @@ VALVE_KEYS = ("min_on_s", "open_delay_s", "close_delay_s", "rise_tau_s", "tail_t
 MANOEUVRE_KINDS = ("step", "mrp_polynomial")
 # statistics fields the bench reads (all optional): see docs/icd.md
 STATS_FIELDS = ("cycles", "overruns", "sent", "received", "second_sender_evidence", "mode",
-                "cycle_time_us", "allocation", "inertia_estimate_B_kgm2", "restarts",
+                "cycle_time_us", "allocation", "inertia_estimate_B_kgm2",
+                "inertia_identification", "restarts",
                 "restarts_refused", "fdir", "warnings", "bus_overrun_drops",
                 "bus_overrun_drops_by_pid")
 Vec3 = tuple[float, float, float]

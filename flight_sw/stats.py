@@ -108,6 +108,9 @@ def stats_record(st: NodeStats, received: dict[str, dict[str, Any]], fc: FlightC
             "active": fc.pose.in_fine_hold, "switches": fc.pose.switches},
         "inertia_estimate_B_kgm2": (
             None if fc.inertia_B_kgm2 is None else fc.inertia_B_kgm2.tolist()),
+        "inertia_identification": None if fc.inertia_id is None else {
+            "updates": fc.inertia_id.n_updates,
+            "withheld_unphysical": fc.inertia_id.n_unphysical},
         "restarts": st.restarts,
         "restarts_refused": restarts_refused,
         "warnings": list(fc.warnings),

@@ -67,8 +67,20 @@ class InertiaIdentifier(Protocol):
 
     Called once per control cycle with the estimated body rate [rad/s] and the torque
     [N m] applied over the period that just ended; returns the current 3×3 estimate
-    [kg m²] (body axes, about the centre of mass), or None while not yet excited enough.
+    [kg m²] (body axes, about the centre of mass), or None while not yet excited enough
+    or while the estimate is the inertia of no body (a principal moment above the sum of
+    the other two).
     """
+
+    @property
+    def n_updates(self) -> int:
+        """Estimation steps taken so far."""
+        ...
+
+    @property
+    def n_unphysical(self) -> int:
+        """Updates whose estimate was withheld as the inertia of no body."""
+        ...
 
     def update(
         self, t_ns: int, omega_BN_B: np.ndarray, torque_B_Nm: np.ndarray

@@ -266,3 +266,61 @@ def test_window_cycles_validated(bad: object) -> None:
     """window_cycles must be an integer >= 1; the error names the key."""
     with pytest.raises(ConfigError, match="window_cycles"):
         RlsInertiaParams(J_GUESS, window_cycles=bad)  # type: ignore[arg-type]
+
+
+# Positive definite but no body's: principal moments (6, 9, 18), 6 + 9 < 18 (a rotated
+# diagonal, so its products of inertia are not zero).
+J_UNPHYSICAL_PRINCIPAL = (6.0, 9.0, 18.0)
+# its identification error (noise-free, measured 2.3e-6) far below its distance from any
+# physical inertia (~20 %)
+UNPHYSICAL_FIT_RTOL = 1e-4
+TRIANGLE_MARGIN = 1e-3  # relative: J3 = (J1 + J2)(1 ± this) either side of the boundary
+ROTATION_RAD = (0.4, -0.7, 0.25)  # an arbitrary rotation vector for the principal axes
+
+
+def _rotated(principal: tuple[float, float, float]) -> np.ndarray:
+    """``C diag(principal) Cᵀ`` for the rotation :data:`ROTATION_RAD` (Rodrigues)."""
+    v = np.array(ROTATION_RAD)
+    angle = float(np.linalg.norm(v))
+    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]]) / angle
+    c = np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+    return c @ np.diag(principal) @ c.T
+
+
+def _fit_exactly(j: np.ndarray) -> tuple[RlsInertiaIdentifier, list[np.ndarray | None]]:
+    """The identifier fed measurement-model data of ``j`` (recovers it to round-off)."""
+    rng = np.random.default_rng(11)
+    ident = RlsInertiaIdentifier(
+        RlsInertiaParams(J_GUESS, forgetting_factor=1.0, initial_covariance=1e8)
+    )
+    theta = inertia_params(j)
+    rates = rng.normal(0.0, 0.2, (60, 3))
+    out = [ident.update(0, rates[0], np.zeros(3))]
+    for k in range(1, len(rates)):
+        y = euler_regressor(rates[k - 1], rates[k], PERIOD_S) @ theta
+        out.append(ident.update(k * PERIOD_NS, rates[k], y))
+    return ident, out
+
+
+def test_unphysical_estimate_is_withheld(clean_data: tuple[np.ndarray, np.ndarray]) -> None:
+    """Data of a positive definite J no body has: identified, but never handed out."""
+    j_bad = _rotated(J_UNPHYSICAL_PRINCIPAL)
+    assert np.all(np.linalg.eigvalsh(j_bad) > 0.0)
+    ident = RlsInertiaIdentifier(RlsInertiaParams(J_GUESS, forgetting_factor=1.0))
+    out = feed(ident, *simulate(j_bad, N_SAMPLES, OMEGA0_B))
+    assert relative_error(ident.inertia_B_kgm2, j_bad) < UNPHYSICAL_FIT_RTOL  # identified
+    assert out[-1] is None
+    assert ident.n_unphysical > 0
+    good = RlsInertiaIdentifier(RlsInertiaParams(J_GUESS, forgetting_factor=1.0))
+    assert feed(good, *clean_data)[-1] is not None and good.n_unphysical == 0
+
+
+@pytest.mark.parametrize("side", [-1.0, 1.0])
+def test_physical_inertia_boundary_is_the_triangle_inequality(side: float) -> None:
+    """J3 just under J1 + J2 is handed out; just over it is withheld (rotated axes)."""
+    j1, j2 = 7.0, 11.0
+    j = _rotated((j1, j2, (j1 + j2) * (1.0 + side * TRIANGLE_MARGIN)))
+    ident, out = _fit_exactly(j)
+    assert relative_error(ident.inertia_B_kgm2, j) < EXACT_RTOL
+    assert (out[-1] is None) == (side > 0.0)
+    assert (ident.n_unphysical > 0) == (side > 0.0)
