@@ -34,6 +34,7 @@ from bench.operator.fsw_process import DEFAULT_FSW_CMD, fsw_argv
 from bench.operator.lifecycle import (
     DiskReserve,
     Stopped,
+    exit_now,
     held_stop_signals,
     stop_on_signals,
     supervise,
@@ -202,9 +203,7 @@ def _fork_and_supervise(
             if not (out / "summary.json").exists():
                 traceback.print_exc()  # nothing else will say what happened
         finally:
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os._exit(code)
+            exit_now(code, (sys.stdout, sys.stderr))
     if prestart is not None:  # the bench holds it now: it ends with the bench
         prestart.release()
     # matplotlib loads while the flight software boots and the run goes (on the core the

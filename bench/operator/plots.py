@@ -28,7 +28,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from bench.operator.lifecycle import STOP_SIGNALS
+from bench.operator.lifecycle import STOP_SIGNALS, exit_now
 from bench.results.record import read_lines, run_file
 from transport.lockstep import available_cpus
 
@@ -160,8 +160,7 @@ def draw_each(figures: list[tuple[Path, Callable[[Path], None]]]) -> list[Path]:
                 traceback.print_exc()
                 code = 1
             finally:
-                sys.stderr.flush()
-                os._exit(code)
+                exit_now(code, (sys.stderr,))
         children.append((pid, path))
     error: BaseException | None = None
     try:

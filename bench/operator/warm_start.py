@@ -42,6 +42,8 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, NoReturn
 
+from bench.operator.lifecycle import exit_now
+
 WARM_ENV = "THRUSTER_HIL_WARM_START"
 """``1``: a bench process starts its flight-software command warm where it can
 (:func:`warm_module`); set by the campaign's zygote in the runs it starts."""
@@ -141,10 +143,7 @@ def run_and_exit(entry: Callable[[], object]) -> NoReturn:
     finally:
         with contextlib.suppress(BaseException):
             atexit._run_exitfuncs()
-        for f in (sys.stdout, sys.stderr):
-            with contextlib.suppress(BaseException):
-                f.flush()
-        os._exit(code)
+        exit_now(code, (sys.stdout, sys.stderr))
 
 
 def run_module(module: str, args: list[str]) -> Callable[[], object]:
