@@ -65,7 +65,9 @@ def exit_now(code: int, flush: Sequence[IO[str]] = ()) -> NoReturn:
     before that raises :class:`Stopped` here, where it is caught (and it ignores every later
     stop signal): without this, a signal landing as a child flushed its output carried the
     child, a copy of its parent, on into the parent's code (a forked bench went on running
-    the rest of a test session).
+    the rest of a test session). The handler can also fire on the way into this function,
+    before its first line: a caller with such a handler calls it in a loop,
+    ``while True: try: exit_now(...) except BaseException: pass``.
     """
     # bare try/except, not contextlib.suppress: its __exit__ is Python code, where a
     # handler could raise again before the mask is set

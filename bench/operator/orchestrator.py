@@ -203,7 +203,11 @@ def _fork_and_supervise(
             if not (out / "summary.json").exists():
                 traceback.print_exc()  # nothing else will say what happened
         finally:
-            exit_now(code, (sys.stdout, sys.stderr))
+            while True:  # a stop's handler may raise on the way into exit_now (it fires once)
+                try:  # noqa: SIM105 - no context manager: its __enter__ could take that raise
+                    exit_now(code, (sys.stdout, sys.stderr))
+                except BaseException:
+                    pass
     if prestart is not None:  # the bench holds it now: it ends with the bench
         prestart.release()
     # matplotlib loads while the flight software boots and the run goes (on the core the

@@ -143,7 +143,11 @@ def run_and_exit(entry: Callable[[], object]) -> NoReturn:
     finally:
         with contextlib.suppress(BaseException):
             atexit._run_exitfuncs()
-        exit_now(code, (sys.stdout, sys.stderr))
+        while True:  # a stop's handler may raise on the way into exit_now (it fires once)
+            try:  # noqa: SIM105 - no context manager: its __enter__ could take that raise
+                exit_now(code, (sys.stdout, sys.stderr))
+            except BaseException:
+                pass
 
 
 def run_module(module: str, args: list[str]) -> Callable[[], object]:
