@@ -260,12 +260,24 @@ def inertia(source: str, key: str, value: object, *, physical: bool = False) -> 
     if not float(moments[0]) > 0.0:
         raise ConfigError(source, key, value,
                           "a positive-definite matrix (every principal moment > 0)")
-    if physical and float(moments[2]) > (float(moments[0]) + float(moments[1])) * (
-        1.0 + INERTIA_TRIANGLE_RTOL
-    ):
+    if physical and not _obeys_triangle(moments):
         raise ConfigError(source, key, value, "principal moments obeying the triangle "
                           "inequality (a physical body)")
     return sym
+
+
+def _obeys_triangle(moments: np.ndarray) -> bool:
+    """Ascending principal moments with λ_max ≤ (λ_1 + λ_2)(1 + INERTIA_TRIANGLE_RTOL)."""
+    return float(moments[2]) <= (float(moments[0]) + float(moments[1])) * (
+        1.0 + INERTIA_TRIANGLE_RTOL)
+
+
+def physical_inertia(sym: np.ndarray) -> bool:
+    """Whether the symmetric 3×3 ``sym`` [kg m²] is some body's inertia: positive definite,
+    its principal moments obeying the triangle inequality (as :func:`inertia` with
+    ``physical`` checks a configured one). For a computed estimate: no exception."""
+    moments = np.linalg.eigvalsh(sym)  # ascending
+    return bool(float(moments[0]) > 0.0) and _obeys_triangle(moments)
 
 
 def instance(source: str, key: str, value: object, cls: type) -> None:

@@ -8,11 +8,13 @@ What it does (numpy arrays in and out; the arithmetic runs on floats in
   (OSQP's, or the previous call's);
 - :func:`refine_on_active_set`: the ε → 0 least-norm least-squares thrusts on the
   active set of a box-QP solution (:data:`ACTIVE_RTOL`), and :func:`refine`, which keeps
-  them when they do not increase the residual (:data:`REFINE_RTOL`).
+  them when they do not increase the residual (:data:`REFINE_RTOL`);
+- :func:`ridge`: the ridge ε that makes ``M = BᵀB + εI`` definite, a fraction of the mean
+  diagonal of ``BᵀB`` (the mean squared column norm of ``B``).
 
-The bounded QP allocator (:mod:`flight_sw.allocation.qp_osqp`) and the robust ones
+The bounded QP allocator (:mod:`flight_sw.allocation.qp_osqp`), the robust ones
 (:mod:`~flight_sw.allocation.robust_polytopic`, :mod:`~flight_sw.allocation.robust_lft`)
-share them.
+and the pseudo-inverse's repair (:mod:`flight_sw.allocation.pseudo_inverse`) share them.
 
 Units: thrusts [N], demands in demand units; ``M`` and ``c`` in the caller's units.
 Assumptions: ``lo ≤ hi`` elementwise (``lo == hi`` holds a variable fixed), finite inputs.
@@ -46,6 +48,14 @@ BOX_XTOL = 1e-12
 BOX_GTOL = 1e-13
 
 __all__ = ["AT_LOWER", "AT_UPPER", "FREE"]
+
+
+def ridge(b: np.ndarray, rtol: float) -> float:
+    """``rtol`` × the mean squared column norm of ``b`` (the mean diagonal of ``bᵀb``);
+    0 for a matrix without columns."""
+    if b.size == 0:
+        return 0.0
+    return rtol * float(np.mean(np.sum(b * b, axis=0)))
 
 
 def bound_active(t: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:

@@ -25,19 +25,20 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
       ``B``), a zonotope — and ``exact_repair`` is on, solve the bounded least-squares
       problem ``min ‖B T − d‖, 0 ≤ T ≤ T_max`` as the box QP ``M = BᵀB + εI``,
       ``c = Bᵀd`` of :func:`flight_sw.allocation.active_set.box_qp` (the exact active-set
-      solver the QP allocators use), which then has a zero residual: an attainable demand
-      is always reproduced exactly. The ridge ``ε`` (:data:`LEAST_NORM_RIDGE_RTOL` × the
-      mean diagonal of ``BᵀB``) picks the least-norm thrusts among the many that reproduce
-      the demand (as ε → 0 the regularised minimiser tends to the least-norm point of the
-      solution set: the Tikhonov limit) and makes ``M`` definite, so the solver's
-      primal-dual rounds settle on Cholesky solves; a least-norm solve on the active set
-      they find then removes the ridge's bias (ε → 0,
-      :func:`flight_sw.allocation.active_set.refine`, as the QP allocators do). Without
-      the ridge (``M`` only semi-definite: rank m < n) the rounds cycled in 295 of the 310
-      repairs of a replay of the quickstart's cycles, the primal active-set method
-      finished from wherever they stopped (~0.6 ms a call, against ~20 µs now) and the
-      answer depended on that path: a minimiser, but not the least-norm one (up to 0.9 N
-      larger in norm; tests/ compare with OSQP's least-norm answer). The attainability
+      solver the QP allocators use), then solve the least-norm least squares on the active
+      set it finds (ε → 0, :func:`flight_sw.allocation.active_set.refine`, as the QP
+      allocators do): a zero residual, so an attainable demand is always reproduced
+      exactly, by the least-norm thrusts of all that reproduce it (as ε → 0 the
+      regularised minimiser tends to the least-norm point of the solution set: the
+      Tikhonov limit). The ridge (:data:`LEAST_NORM_RIDGE_RTOL` × the mean diagonal of
+      ``BᵀB``, :func:`~flight_sw.allocation.active_set.ridge`) makes ``M`` definite, so
+      the primal-dual rounds settle on Cholesky solves. Without it (``M`` only
+      semi-definite: rank m < n) they cycled in 295 of 310 repairs in a replay of a
+      quickstart run's cycles on its true states (``benchmarks/fsw_cycle.py``'s hot
+      replay; runs need far fewer repairs), the primal active-set method finished from
+      wherever they stopped (~0.6 ms a call, against ~20 µs now) and the answer depended
+      on that path: a minimiser, but not the least-norm one (up to 0.9 N larger in norm;
+      tests/ compare with OSQP's least-norm answer). The attainability
       test is one small matrix-vector product against the facet inequalities
       ``n·x ≤ h(n)`` precomputed at construction: a facet normal ``n`` is orthogonal to r − 1
       independent generators (the bounds scale the generators, not their directions,
@@ -102,13 +103,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc import validation as check
-from flight_sw.allocation.active_set import FREE, box_qp, refine
+from flight_sw.allocation.active_set import FREE, box_qp, refine, ridge
 from flight_sw.allocation.base import RANK_RTOL, BoundSpec, ControlAllocation
 from flight_sw.allocation.linear_program import solve_lp
 
 # The bounded least squares' ridge ε relative to the mean diagonal of BᵀB (step 3a, the
-# fallback): small enough to leave the residual at round-off (< 1e-13 in the objective on
-# the quickstart's repairs), large enough for Cholesky pivots far above PD_PIVOT_RTOL.
+# fallback): large enough for Cholesky pivots far above PD_PIVOT_RTOL, small enough that
+# its active set is the least-norm answer's; its own residual (up to ~1e-7, several times
+# the attained tolerance) is removed by the refinement on that active set.
 LEAST_NORM_RIDGE_RTOL = 1e-9
 # Smallest component (of a unit-sum null vector) accepted as "strictly positive".
 NULL_VECTOR_MIN_COMPONENT = 1e-9
@@ -235,10 +237,9 @@ class PseudoInverseAllocator(ControlAllocation):
         self._overflow_N = u_a * (1.0 + THRUST_RTOL)
         # BᵀB + εI of the bounded least squares (array and lists, as the QP allocators keep
         # M): the ridge makes the answer the least-norm one and M definite (docstring, 3a)
-        gram = b_a.T @ b_a
-        ridge = LEAST_NORM_RIDGE_RTOL * float(np.mean(np.diag(gram))) if gram.size else 0.0
-        self._m_mat = gram + ridge * np.eye(gram.shape[0])
-        self._definite = ridge > 0.0
+        eps = ridge(b_a, LEAST_NORM_RIDGE_RTOL)
+        self._m_mat = b_a.T @ b_a + eps * np.eye(b_a.shape[1])
+        self._definite = eps > 0.0
         self._m_list = self._m_mat.tolist()
         self._free = np.full(u_a.size, FREE, dtype=np.int8)
         self._halfspaces: tuple[np.ndarray, np.ndarray] | None = None
@@ -276,7 +277,8 @@ class PseudoInverseAllocator(ControlAllocation):
         ridge of ``M``)."""
         x, _ = box_qp(self._m_mat, self._b_a.T @ d, self._lo_a, self._hi_a, self._free,
                       self._definite, self._m_list)
-        # ε → 0 on the ridge's active set: exact (the ridge leaves ~1e-8 of residual)
+        # ε → 0 on the ridge's active set: the refinement makes the repair exact (the
+        # ridge's answer alone misses an attainable demand by up to ~1e-7)
         return refine(self._b_a, d, x, self._lo_a, self._hi_a, self._attained_tol**2)
 
     def _in_range_residual(self, d: np.ndarray, t_a: np.ndarray) -> float:

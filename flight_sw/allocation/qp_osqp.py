@@ -81,6 +81,7 @@ from flight_sw.allocation.active_set import (
     FREE,
     box_qp,
     refine,
+    ridge,
 )
 from flight_sw.allocation.base import (
     MAX_DEMAND_DIM,
@@ -154,8 +155,7 @@ class BoundedQpAllocator(ControlAllocation):
         k = self._avail.size
         self._osqp: Any = None
         if k:
-            gram_diag = np.sum(self._b_w * self._b_w, axis=0)
-            eps = params.regularization * float(np.mean(gram_diag))
+            eps = ridge(self._b_w, params.regularization)
             p = sp.block_diag([eps * sp.identity(k), sp.diags(w)], format="csc")
             a = sp.bmat(
                 [[sp.csc_matrix(b_a), -sp.identity(m)], [sp.identity(k), None]], format="csc"

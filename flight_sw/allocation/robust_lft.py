@@ -95,7 +95,7 @@ import numpy as np
 
 from dbc import validation as check
 from dbc.errors import ConfigError
-from flight_sw.allocation.active_set import FREE, bound_active, box_qp, refine
+from flight_sw.allocation.active_set import FREE, bound_active, box_qp, refine, ridge
 from flight_sw.allocation.base import (
     RANK_RTOL,
     BoundSpec,
@@ -220,7 +220,7 @@ class RobustLftAllocator(ControlAllocation):
         self._eig_u = u
         self._uncertain = s_max > 0.0 and bool(np.any(h_a != 0.0))
         k = self._avail.size
-        self._eps = params.regularization * float(np.mean(np.sum(b_a * b_a, axis=0))) if k else 0.0
+        self._eps = ridge(b_a, params.regularization)
         self._definite = self._eps > 0.0
         self._s_max = s_max
         # Eigenbasis data: C = UᵀB₀ (rows along the eigenvectors of EEᵀ), HᵀH, B₀ᵀB₀.

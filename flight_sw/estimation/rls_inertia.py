@@ -37,12 +37,12 @@ scaled down whenever its trace exceeds that of ``P_0`` (constant-trace bound).
 Excitation: the identifier also keeps the discounted information matrix
 ``R_k = λ R_{k−1} + Φ_kᵀ Φ_k`` [(rad/s²)²]; :meth:`RlsInertiaIdentifier.update` returns
 the estimate only while ``λ_min(R_k) > min_information`` and the estimate is the inertia
-of some mass distribution, else None (so a caller keeps its last good inertia): positive
-definite and with a positive definite second-moment matrix ``½ tr(J) I − J`` (the
-triangle inequalities ``J_i + J_j > J_k`` of the principal moments; Wensing, Kim &
-Slotine 2018, IEEE RA-L 3(1), "Linear matrix inequalities for physically consistent
-inertial parameter identification"), all tested by Cholesky. Positive definiteness alone
-let through estimates no body has: on the capture scenario at seed 6, just after the
+of some body, else None (so a caller keeps its last good inertia): positive definite (the
+kernel's Cholesky test) and with principal moments obeying the triangle inequality
+``λ_max ≤ λ_1 + λ_2`` (:func:`dbc.validation.physical_inertia`, the test a configured
+inertia passes; equivalently the second-moment matrix ``½ tr(J) I − J`` is positive
+semi-definite: Wensing, Kim & Slotine 2018). Positive definiteness alone let through
+estimates no body has: on the capture scenario at seed 6, just after the
 capture (its window mixes the two bodies' data), principal moments (0.005, 3.0, 23.4)
 kg m² (0.005 + 3.0 < 23.4); the MRP law, told them, pushed the wrong way for 26 s (a 36°
 error, then a tumble), where told nothing it keeps the pre-capture inertia and converges.
@@ -66,7 +66,10 @@ ratio of the rate-difference noise power to the excitation power.
 Source: seed 001 ("Attitude control and structure robust control allocation for combined
 spacecraft"), §2: Euler
 equation (2), the RLS equations with forgetting factor and Remark 1; the regressor
-parametrisation of the momentum-based identification the seed cites as [7].
+parametrisation of the momentum-based identification the seed cites as [7]. The physical
+gate: Wensing, Kim & Slotine 2018, "Linear matrix inequalities for physically consistent
+inertial parameter identification: a statistical perspective on the mass distribution",
+IEEE Robotics and Automation Letters 3(1) 60–67.
 
 Computation: the per-cycle arithmetic (regressor, window sums, RLS step, gates) runs on
 floats in :mod:`flight_sw.estimation.rls_kernel` (compiled), its one implementation; the
@@ -150,7 +153,7 @@ class _Window:
 
 
 def _inertia_tuple(value: object) -> tuple[tuple[float, float, float], ...]:
-    sym = check.inertia(_SOURCE, "inertia_guess_B_kgm2", value)
+    sym = check.inertia(_SOURCE, "inertia_guess_B_kgm2", value, physical=True)
     return tuple((float(r[0]), float(r[1]), float(r[2])) for r in sym)
 
 
@@ -159,7 +162,7 @@ class RlsInertiaParams:
     """RLS inertia-identification parameters.
 
     Attributes:
-        inertia_guess_B_kgm2: initial estimate θ_0 (3×3, symmetric, positive definite)
+        inertia_guess_B_kgm2: initial estimate θ_0 (3×3, symmetric, some body's inertia)
             [kg m²], body axes about the centre of mass; stored as a tuple of rows.
         forgetting_factor: λ in (0, 1] (1: no forgetting).
         initial_covariance: α > 0 in P_0 = α I6 [(kg m²)²]; the prior weighs 1/α.
@@ -245,8 +248,9 @@ class RlsInertiaIdentifier:
 
     @property
     def n_unphysical(self) -> int:
-        """Updates whose estimate was withheld as the inertia of no mass distribution
-        (positive definite, but a principal moment above the sum of the other two)."""
+        """Calls of :meth:`update` (cycles) whose estimate was withheld as no body's inertia
+        (positive definite, but a principal moment above the sum of the other two), since
+        construction (a reset keeps the count)."""
         return self._n_unphysical
 
     def reset(self, inertia_guess_B_kgm2: np.ndarray | None = None) -> None:
@@ -270,9 +274,9 @@ class RlsInertiaIdentifier:
     ) -> np.ndarray | None:
         """Take the rate at ``t_ns`` and the mean torque of the period ending at ``t_ns``.
 
-        Returns the current estimate (3×3) [kg m²] if excited enough and positive
-        definite, else None. A non-finite input, a non-increasing time or a gap above
-        ``max_gap_s`` drops the pair of samples (the differencing restarts).
+        Returns the current estimate (3×3) [kg m²] if excited enough and some body's
+        inertia (module docstring), else None. A non-finite input, a non-increasing time
+        or a gap above ``max_gap_s`` drops the pair of samples (the differencing restarts).
         """
         w = _vector3(omega_BN_B)
         tau = _vector3(torque_B_Nm)
@@ -309,8 +313,8 @@ class RlsInertiaIdentifier:
         self._n_updates += 1
 
     def _output(self) -> np.ndarray | None:
-        """The estimate while ``λ_min(R) > min_information`` and it is a physical inertia
-        (positive definite, and so is ``½ tr(J) I − J``: module docstring)."""
+        """The estimate while ``λ_min(R) > min_information`` and it is some body's inertia
+        (positive definite, the triangle inequality: module docstring)."""
         if self._n_updates == 0:
             return None
         if not kernel.exceeds(self._info, self._params.min_information):
@@ -319,13 +323,11 @@ class RlsInertiaIdentifier:
         j = [[j11, j12, j13], [j12, j22, j23], [j13, j23, j33]]
         if not kernel.exceeds(j, 0.0):
             return None
-        half_trace = 0.5 * (j11 + j22 + j33)
-        second_moment = [[(half_trace if r == c else 0.0) - j[r][c] for c in range(3)]
-                         for r in range(3)]
-        if not kernel.exceeds(second_moment, 0.0):
+        estimate = np.array(j)
+        if not check.physical_inertia(estimate):
             self._n_unphysical += 1
             return None
-        return np.array(j)
+        return estimate
 
 
 def _scaled_identity(value: float) -> list[list[float]]:

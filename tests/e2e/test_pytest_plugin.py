@@ -23,7 +23,13 @@ from typing import Any
 import numpy as np
 import pytest
 
-from bench.operator.analysis.reception import PAIRING_TOLERANCE_S
+from bench.operator.analysis.reception import (
+    PAIRING_TOLERANCE_S,
+    RX_LOG_COLUMNS,
+    RX_LOG_FILE,
+    receive_log,
+)
+from bench.operator.analysis.tables import read_csv_columns
 from bench.operator.analysis.timing import RunTiming
 from tests.e2e.conftest import QUICKSTART, REPO, run_cli, unique_bus
 
@@ -47,6 +53,9 @@ GUEST_PAIRED_SHARE_MIN = 0.5
 # Frames of each checked message the bench must send while the flight software still reads:
 # a second of the slowest one (STR_QUAT, 10 Hz).
 LISTENED_MIN = 10
+# The flight software's last logged reception falls at least this far into the realtime
+# run (it reads until the bench ends; the bench's lag in the guest only delays that end).
+LAST_READ_MIN_FRACTION = 0.5
 USAGE_ERROR = 4  # pytest's exit code for a usage error
 EXAMPLES = REPO / "tests" / "timing_examples"
 VCAN = Path("/sys/class/net/vcan0")
@@ -211,6 +220,8 @@ def _check_bench_frames_received(
     # run's end (many in the emulated guest, where the bench lags the wall clock and sends on
     # as it catches up)
     last_rx_s = _last_logged_rx_s(run_dir)
+    # it read on at least through the first half of the run (stopping early is a failure)
+    assert last_rx_s >= LAST_READ_MIN_FRACTION * float(REALTIME_S), last_rx_s
     for name in ("IMU_RATE", "STR_QUAT", "THR_STATUS"):
         m = t["messages"][name]
         assert m["time_source"] in ("t_rx", "mixed"), name
@@ -228,8 +239,9 @@ def _check_bench_frames_received(
 def _last_logged_rx_s(run_dir: Path) -> float:
     """The flight software's last reception in ``fsw_rx.csv``, on the run's time base [s]."""
     origin = json.loads((run_dir / "summary.json").read_text())["wall_clock_origin_s"]
-    rows = (run_dir / "fsw_rx.csv").read_text().splitlines()[1:]
-    return max(float(r.split(",")[0]) for r in rows) - float(origin)
+    log = receive_log(read_csv_columns(run_dir / RX_LOG_FILE, RX_LOG_COLUMNS), float(origin))
+    assert log.t_rx_s.size > 0, "fsw_rx.csv has no rows"
+    return float(np.max(log.t_rx_s))
 
 
 def _check_live(live: dict[str, Any], bus: str, latency_known: bool) -> None:

@@ -109,18 +109,32 @@ def test_noise_free_converges_to_truth(clean_data: tuple[np.ndarray, np.ndarray]
             assert np.max(np.abs(j - j.T)) <= SYMMETRY_TOL
 
 
-def test_exact_regression_data_is_fitted_to_round_off() -> None:
-    """With y = Φ θ exactly (the measurement model itself), RLS recovers θ to round-off."""
-    rng = np.random.default_rng(11)
+# Measurement-model data (y = Φ θ exactly): random rates, a wide prior.
+EXACT_DATA_SEED = 11
+EXACT_RATE_SIGMA_RAD_S = 0.2
+EXACT_SAMPLES = 60
+EXACT_INITIAL_COVARIANCE = 1e8
+
+
+def _fit_exactly(j: np.ndarray) -> tuple[RlsInertiaIdentifier, list[np.ndarray | None]]:
+    """The identifier fed measurement-model data of ``j`` (recovers it to round-off)."""
+    rng = np.random.default_rng(EXACT_DATA_SEED)
     ident = RlsInertiaIdentifier(
-        RlsInertiaParams(J_GUESS, forgetting_factor=1.0, initial_covariance=1e8)
+        RlsInertiaParams(J_GUESS, forgetting_factor=1.0,
+                         initial_covariance=EXACT_INITIAL_COVARIANCE)
     )
-    theta = inertia_params(J_TRUE)
-    rates = rng.normal(0.0, 0.2, (60, 3))
-    ident.update(0, rates[0], np.zeros(3))
+    theta = inertia_params(j)
+    rates = rng.normal(0.0, EXACT_RATE_SIGMA_RAD_S, (EXACT_SAMPLES, 3))
+    out = [ident.update(0, rates[0], np.zeros(3))]
     for k in range(1, len(rates)):
         y = euler_regressor(rates[k - 1], rates[k], PERIOD_S) @ theta
-        ident.update(k * PERIOD_NS, rates[k], y)
+        out.append(ident.update(k * PERIOD_NS, rates[k], y))
+    return ident, out
+
+
+def test_exact_regression_data_is_fitted_to_round_off() -> None:
+    """With y = Φ θ exactly (the measurement model itself), RLS recovers θ to round-off."""
+    ident, _ = _fit_exactly(J_TRUE)
     assert relative_error(ident.inertia_B_kgm2, J_TRUE) < EXACT_RTOL
 
 
@@ -271,8 +285,8 @@ def test_window_cycles_validated(bad: object) -> None:
 # Positive definite but no body's: principal moments (6, 9, 18), 6 + 9 < 18 (a rotated
 # diagonal, so its products of inertia are not zero).
 J_UNPHYSICAL_PRINCIPAL = (6.0, 9.0, 18.0)
-# its identification error (noise-free, measured 2.3e-6) far below its distance from any
-# physical inertia (~20 %)
+# its identification error (noise-free, measured 2.3e-6) far below its distance from the
+# nearest physical inertia (principal moments (7, 10, 17): 8 %)
 UNPHYSICAL_FIT_RTOL = 1e-4
 TRIANGLE_MARGIN = 1e-3  # relative: J3 = (J1 + J2)(1 ± this) either side of the boundary
 ROTATION_RAD = (0.4, -0.7, 0.25)  # an arbitrary rotation vector for the principal axes
@@ -285,21 +299,6 @@ def _rotated(principal: tuple[float, float, float]) -> np.ndarray:
     k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]]) / angle
     c = np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
     return c @ np.diag(principal) @ c.T
-
-
-def _fit_exactly(j: np.ndarray) -> tuple[RlsInertiaIdentifier, list[np.ndarray | None]]:
-    """The identifier fed measurement-model data of ``j`` (recovers it to round-off)."""
-    rng = np.random.default_rng(11)
-    ident = RlsInertiaIdentifier(
-        RlsInertiaParams(J_GUESS, forgetting_factor=1.0, initial_covariance=1e8)
-    )
-    theta = inertia_params(j)
-    rates = rng.normal(0.0, 0.2, (60, 3))
-    out = [ident.update(0, rates[0], np.zeros(3))]
-    for k in range(1, len(rates)):
-        y = euler_regressor(rates[k - 1], rates[k], PERIOD_S) @ theta
-        out.append(ident.update(k * PERIOD_NS, rates[k], y))
-    return ident, out
 
 
 def test_unphysical_estimate_is_withheld(clean_data: tuple[np.ndarray, np.ndarray]) -> None:
