@@ -37,6 +37,14 @@ def matrix(layout: tuple[np.ndarray, np.ndarray], rows: str) -> np.ndarray:
     return b[TORQUE_ROWS] if rows == "torque" else b
 
 
+def repaired_and_plain(
+    b: np.ndarray, tmax: float
+) -> tuple[PseudoInverseAllocator, PseudoInverseAllocator]:
+    """The allocator with its exact repair (step 3a) and the same without it."""
+    return (PseudoInverseAllocator(b, PseudoInverseParams(tmax)),
+            PseudoInverseAllocator(b, PseudoInverseParams(tmax, exact_repair=False)))
+
+
 def assert_within_bounds(thrust: np.ndarray, tmax: float) -> None:
     """Every thrust in [0, T_max]."""
     assert np.all(thrust >= 0.0)
@@ -49,8 +57,7 @@ def test_reproduces_every_feasible_demand_exactly(
 ) -> None:
     """Random attainable demands B·T, T ∈ [0, T_max]^8 (vertices included), are reproduced."""
     b = matrix(layout, rows)
-    alloc = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n))
-    plain = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n, exact_repair=False))
+    alloc, plain = repaired_and_plain(b, max_thrust_n)
     overflowed = 0
     samples = np.vstack(
         [
@@ -105,8 +112,7 @@ def test_repair_gives_the_least_norm_exact_thrusts(
 ) -> None:
     """Overflowing attainable demands: the repair's thrusts are the least-norm exact ones."""
     b = matrix(layout, rows)
-    alloc = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n))
-    plain = PseudoInverseAllocator(b, PseudoInverseParams(max_thrust_n, exact_repair=False))
+    alloc, plain = repaired_and_plain(b, max_thrust_n)
     checked = 0
     # thrusts clipped from a wider range: about a quarter at each bound, half inside
     lo, hi = CLIPPED_DRAW_RANGE
