@@ -68,8 +68,8 @@ class InertiaIdentifier(Protocol):
     Called once per control cycle with the estimated body rate [rad/s] and the torque
     [N m] applied over the period that just ended; returns the current 3×3 estimate
     [kg m²] (body axes, about the centre of mass), or None while not yet excited enough
-    or while the estimate is the inertia of no body (a principal moment at or above the
-    sum of the other two).
+    or while the estimate is the inertia of no body (a principal moment above the sum of
+    the other two).
     """
 
     @property

@@ -67,9 +67,12 @@ Source: seed 001 ("Attitude control and structure robust control allocation for 
 spacecraft"), §2: Euler
 equation (2), the RLS equations with forgetting factor and Remark 1; the regressor
 parametrisation of the momentum-based identification the seed cites as [7]. The physical
-gate: Wensing, Kim & Slotine 2018, "Linear matrix inequalities for physically consistent
-inertial parameter identification: a statistical perspective on the mass distribution",
-IEEE Robotics and Automation Letters 3(1) 60–67.
+gate: Traversaro, Brossette, Escande & Nori 2016, "Identification of fully physical
+consistent inertial parameters using optimization on manifolds" (IROS; arXiv:1610.08703:
+positive definiteness and the triangle inequality); Wensing, Kim & Slotine 2018, "Linear
+matrix inequalities for physically consistent inertial parameter identification: a
+statistical perspective on the mass distribution" (IEEE RA-L; arXiv:1701.04395: the
+second-moment form).
 
 Computation: the per-cycle arithmetic (regressor, window sums, RLS step, gates) runs on
 floats in :mod:`flight_sw.estimation.rls_kernel` (compiled), its one implementation; the
