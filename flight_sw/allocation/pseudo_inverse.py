@@ -36,7 +36,7 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
       semi-definite: rank m < n) they cycled in 295 of 310 repairs in a replay of a
       quickstart run's cycles on its true states (``benchmarks/fsw_cycle.py``'s hot
       replay; runs need far fewer repairs), the primal active-set method finished from
-      wherever they stopped (~0.6 ms a call, against ~20 µs now) and the answer depended
+      wherever they stopped (~0.6 ms a call, against ~40 µs now) and the answer depended
       on that path: a minimiser, but not the least-norm one (up to 0.9 N larger in norm;
       tests/ compare with OSQP's least-norm answer). The attainability
       test is one small matrix-vector product against the facet inequalities
@@ -53,7 +53,7 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
    attainable demand. For the seed-003 layout the shifted pseudo-inverse needs up to
    1.5 T_max on attainable demands (e.g. thrusters 3, 4, 5, 6 and 8 all at T_max need
    1.25 T_max); about 0.6 % (torque) and 2 % (wrench) of demands ``B·U(0, T_max)⁸``
-   overflow. Step 3a runs only for those (≈ 20 µs each); unattainable demands,
+   overflow. Step 3a runs only for those (≈ 40 µs each); unattainable demands,
    the common saturated case during slews, take the cheap step 3b.
    With equal bounds every quantity above is computed exactly as the scalar form did
    (``h = T_max Σ_j max(n·g_j, 0)``, ``s = T_max / max T``), bit for bit: the bounds
@@ -62,7 +62,7 @@ opposing valves of 2.35 N and 2.3 N), in up to three cheap steps:
 
 Fallback: when no strictly positive null vector exists (fewer or badly placed available
 thrusters, e.g. after masking), steps 1–3 do not apply and every call solves the bounded
-least-squares problem as that box QP (≈ 20 µs per call): feasible demands are
+least-squares problem as that box QP (≈ 40 µs per call): feasible demands are
 reproduced, others get the bounded least-squares optimum (not direction-preserving).
 :attr:`PseudoInverseAllocator.uses_null_space_shift` tells which path an instance uses.
 
