@@ -11,9 +11,13 @@ velocity, eq. 21). So Z is moved by giving V_s a value for a while: Step C repea
   and the first starts when Z plus the shift they and the settles between them make
   (:meth:`StepC.stop_shift_m`) reaches 0;
 - **stop**: Step B sets ``V_s = 0``;
-until |Z| ≤ ``position_tol_m`` (each round takes what the last one left; seed 004 §3.4
+until |Z| ≤ ``position_tol_m`` or no round fits before the stop (``out_of_turns``: Z is
+left as it is; each round takes what the last one left; seed 004 §3.4
 repeats its sequences the same way, with the remainder form of eq. 35 keeping the
 target continuous, which fixing ψ_f does here).
+
+:func:`choose_stop_turn` picks the stop turn for the supervisor: the earliest whose Z
+can reach 0 in time, riding the stopping velocity the body already has when that does.
 
 Inputs per cycle: time [s], ``q_BR``, ``omega_BN_B`` [rad/s], ψ (unwrapped) [rad], z and
 v_z in the target frame [m, m/s]. Output: the torque demand in body axes [N m].
@@ -36,6 +40,32 @@ from flight_sw.control.underactuated.step_b import StepB
 
 _SOURCE = "[flight_sw.pose] step C"
 MIN_SPEED_TOLS = 4.0  # the least going speed, in Step B's velocity tolerances
+
+
+def choose_stop_turn(psi_rad: float, z_m: float, omega_III_rad_s: float,
+                     v_stop_m_s: float, kappa_m: float, first_turn: int,
+                     reserve_turns: float, max_speed_m_s: float,
+                     max_extra_turns: int = 200) -> tuple[int, float | None]:
+    """The stop turn n (ψ_f = 2πn, from ``first_turn`` on, later turns being lower: a
+    negative spin) for Step C: the earliest whose stopping position Z_n = z − κ(ψ − 2πn)
+    can reach 0 in the time left before that stop less ``reserve_turns``, carried there by
+    the stopping velocity the body already has (no kick to go: returned with its move time
+    −Z_n/V_s [s]) or else at ``max_speed_m_s`` (move time None: Step C's own). The later
+    the stop, the farther Z_n (2πκ a turn) but the longer the time, so a speed above
+    κ|ω_III| always finds one; ``max_extra_turns`` bounds the search."""
+    w = max(abs(omega_III_rad_s), 1e-9)
+    n = first_turn
+    for n in range(first_turn, first_turn - max_extra_turns, -1):
+        left_s = (psi_rad - TWO_PI * n - reserve_turns * TWO_PI) / w
+        z_stop = stopping_position_m(z_m, psi_rad, TWO_PI * n, kappa_m)
+        if left_s <= 0.0:
+            continue
+        if (z_stop * v_stop_m_s < 0.0 and abs(v_stop_m_s) <= max_speed_m_s
+                and -z_stop / v_stop_m_s <= left_s):
+            return n, -z_stop / v_stop_m_s
+        if abs(z_stop) <= max_speed_m_s * left_s:
+            return n, None
+    return n, None
 
 
 class Phase(enum.Enum):
@@ -80,21 +110,27 @@ class StepC:
         self.psi_f_rad = 0.0
         self.reserve_turns = params.reserve_turns
         self.tol_m = params.position_tol_m
+        self.move_time_s = params.move_time_s
         self.rounds = 0
+        #: the last round found no time left before the stop (Z left as it was)
+        self.out_of_turns = False
         self._shift_m = 0.0
         self._sign = 0.0
 
     def start(self, psi_f_rad: float, reserve_turns: float | None = None,
-              tol_m: float | None = None) -> None:
+              tol_m: float | None = None, move_time_s: float | None = None) -> None:
         """Begin moving Z to within ``tol_m`` of 0 for a spin that stops at ``psi_f_rad``
-        (unwrapped), its first round keeping ``reserve_turns`` before the stop (defaults:
-        the parameters')."""
+        (unwrapped), its first round keeping ``reserve_turns`` before the stop and taking
+        ``move_time_s`` (defaults: the parameters')."""
         self.psi_f_rad = check.number(_SOURCE, "psi_f_rad", psi_f_rad)
         self.reserve_turns = (self.p.reserve_turns if reserve_turns is None
                               else check.positive(_SOURCE, "reserve_turns", reserve_turns))
         self.tol_m = (self.p.position_tol_m if tol_m is None
                       else check.positive(_SOURCE, "tol_m", tol_m))
+        self.move_time_s = (self.p.move_time_s if move_time_s is None
+                            else check.positive(_SOURCE, "move_time_s", move_time_s))
         self.rounds = 0
+        self.out_of_turns = False
         self.phase = Phase.CHECK
 
     def z_stop_m(self, z_m: float, psi_rad: float) -> float:
@@ -125,9 +161,15 @@ class StepC:
                 self.phase = Phase.DONE
             else:
                 w = max(abs(float(omega_BN_B[2])), 1e-9)
-                reserve = self.reserve_turns if self.rounds == 0 else self.p.reserve_turns
+                first = self.rounds == 0
+                reserve = self.reserve_turns if first else self.p.reserve_turns
+                move_s = self.move_time_s if first else self.p.move_time_s
                 coast_s = (psi_rad - self.psi_f_rad - reserve * TWO_PI) / w
-                u = -z_stop / max(min(self.p.move_time_s, coast_s), self.period_s)
+                if coast_s < self.p.settle_s:
+                    self.phase = Phase.DONE  # no turns left for a round: Z as it is
+                    self.out_of_turns = True
+                    return self.b.hold.track(omega_BN_B, self.b.hold.pointing_rate(q_BR))
+                u = -z_stop / min(move_s, coast_s)
                 # at least a few of Step B's tolerances, so that the go is a real change
                 u = math.copysign(min(self.p.max_speed_m_s, max(
                     abs(u), MIN_SPEED_TOLS * self.b.p.velocity_tol_m_s)), u)

@@ -45,6 +45,7 @@ from flight_sw.control.underactuated.despin import (
 from flight_sw.control.underactuated.geometry import ThreeThrusters
 
 _SOURCE = "[flight_sw.pose] step D"
+MIN_SPEED_TOLS = 2.0  # the least transfer speed, in velocity tolerances
 
 
 class Phase(enum.Enum):
@@ -58,19 +59,20 @@ class Phase(enum.Enum):
 
 @dataclass(frozen=True)
 class StepDParams:
-    """Tolerances [m, m/s], transfer lead [s], speed limit [m/s], spin kept per sequence,
-    end of the final turn [rad]."""
+    """Tolerances [m, m/s], transfer lead [s] and its least length in spin periods,
+    speed limit [m/s], spin kept per sequence, end of the final turn [rad]."""
 
-    position_tol_m: float = 0.003
+    position_tol_m: float = 0.005
     velocity_tol_m_s: float = 5e-5
     transfer_lead_s: float = 40.0
+    lead_turns: float = 1.5
     max_transfer_speed_m_s: float = 0.02
     keep_spin_fraction: float = 0.5
     final_angle_tol_rad: float = 1e-3
 
     def __post_init__(self) -> None:
         for key in ("position_tol_m", "velocity_tol_m_s", "transfer_lead_s",
-                    "max_transfer_speed_m_s", "final_angle_tol_rad"):
+                    "lead_turns", "max_transfer_speed_m_s", "final_angle_tol_rad"):
             check.positive(_SOURCE, key, getattr(self, key))
         if not 0.0 < self.keep_spin_fraction < 1.0:
             raise ConfigError(_SOURCE, "keep_spin_fraction", self.keep_spin_fraction,
@@ -121,21 +123,32 @@ class StepD:
         return -final_turn_offset_m(math.remainder(self.psi_f_rad, TWO_PI), self.lam,
                                     self.alpha)
 
-    def _transfer_velocity(self, r_from: np.ndarray) -> np.ndarray:
+    def lead_s(self, w3: float) -> float:
+        """The transfer's lead time: ``transfer_lead_s``, or ``lead_turns`` spin periods if
+        longer (a sequence waits up to a turn for its start angle and lasts half a turn:
+        a lead shorter than that overshoots and rings as the spin slows) [s]."""
+        return max(self.p.transfer_lead_s, self.p.lead_turns * TWO_PI / max(abs(w3), 1e-9))
+
+    def _transfer_velocity(self, r_from: np.ndarray, w3: float) -> np.ndarray:
         """The x–y velocity that closes the gap to the aim point in the transfer lead time
         (at most the transfer speed; zero once inside the position tolerance) [m/s]."""
         err = self.aim_m() - r_from
         if not self.transfer or float(np.linalg.norm(err)) <= self.p.position_tol_m:
             return np.zeros(2)
-        v_des = err / self.p.transfer_lead_s
+        v_des = err / self.lead_s(w3)
         speed = float(np.linalg.norm(v_des))
-        if speed > self.p.max_transfer_speed_m_s:
+        # no slower than a few velocity tolerances (a slower demand is inside the
+        # tolerance: no sequence would ever close the last millimetres)
+        least = MIN_SPEED_TOLS * self.p.velocity_tol_m_s
+        if speed < least:
+            v_des *= least / speed
+        elif speed > self.p.max_transfer_speed_m_s:
             v_des *= self.p.max_transfer_speed_m_s / speed
         return v_des
 
     def _plan(self, psi: float, w3: float, r: np.ndarray, v: np.ndarray) -> Despin | None:
         """The next velocity sequence, or None if the drift already fits the plan."""
-        v_des = self._transfer_velocity(r)
+        v_des = self._transfer_velocity(r, w3)
         if float(np.linalg.norm(v_des - v)) <= self.p.velocity_tol_m_s:
             return None
         limit = max_half_turn_dv(w3, self.lam, self.p.keep_spin_fraction)
@@ -143,6 +156,8 @@ class StepD:
         for _ in range(3):  # aim from where the sequence will start and end
             dv = v_des - v
             size = float(np.linalg.norm(dv))
+            if seq is not None and size <= self.p.velocity_tol_m_s:
+                break  # aimed from its end, no change is asked: keep the last plan
             if size > limit:
                 dv *= limit / size
             seq = half_turn_for(dv, w3, self.lam, self.alpha)
@@ -150,8 +165,15 @@ class StepD:
             seq = Despin(psi_a, w3, seq.omega_b_rad_s, seq.eta_per_s)
             wait_s = (psi - psi_a) / abs(w3)
             v_des = self._transfer_velocity(
-                r + v * wait_s + seq.delta_r(v, self.lam, self.alpha))
+                r + v * wait_s + seq.delta_r(v, self.lam, self.alpha), w3)
         return seq
+
+    def _postpone(self) -> float:
+        """Stop one turn later; returns the final turn's new start angle [rad]."""
+        self.psi_f_rad -= TWO_PI
+        self.postponed_turns += 1
+        self.sequence = None
+        return self.psi_f_rad + TWO_PI
 
     def torque_III_Nm(self, psi: float, w3: float, r_xy: np.ndarray, v_xy: np.ndarray) -> float:
         """The axis-III torque to add this cycle [N m] (≥ 0)."""
@@ -176,20 +198,18 @@ class StepD:
         # torque is scaled by the part of the period after the crossing (the same
         # impulse; a turn started δ late ends about λ δ off, 8 mm per mrad at λ = 2 m)
         step = abs(w3) * self.period_s
+        while psi < start_final - step:  # passed while Step D was not running: too late
+            start_final = self._postpone()
         if psi - step < start_final:
             if self.settled(r_xy, v_xy):
                 self.phase = Phase.FINAL
                 after = min(1.0, (start_final - (psi - step)) / step) if step > 0.0 else 1.0
                 return after * self.j3 * w3 * w3 / TWO_PI
-            self.psi_f_rad -= TWO_PI  # not ready: stop one turn later
-            self.postponed_turns += 1
-            self.sequence = None
+            start_final = self._postpone()  # not ready: stop one turn later
         if self.sequence is None:
             self.sequence = self._plan(psi, w3, np.asarray(r_xy), np.asarray(v_xy))
             while self.sequence is not None and self.sequence.psi_b_rad < start_final:
-                self.psi_f_rad -= TWO_PI  # it ends after the final turn's start: a turn later
-                self.postponed_turns += 1
-                start_final -= TWO_PI
+                start_final = self._postpone()  # it ends after the final turn's start
         if self.sequence is not None and psi <= self.sequence.psi_a_rad:
             self.phase = Phase.VELOCITY
             self.sequences += 1

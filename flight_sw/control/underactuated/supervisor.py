@@ -1,22 +1,30 @@
-"""Seed 004's switching controller: Steps A to D in turn, from any state to rest (in progress).
+"""Seed 004's switching controller: Steps A to D in turn, from rest to rest at the target.
 
 What it does (seed 004 §3.1, Figure 3, with the x–y transfer made a step of its own):
 1. **Step A** until single spin (axis III along the target z, transverse rates ~0);
 2. **stop drift**: one of Step D's half-turn velocity sequences takes out the x–y velocity
    Step A left (``drift_tol_m_s``);
-3. **transfer**: Step D's velocity sequences take x–y to the aim point at rest (their stop
-   angle set far ahead, never reached);
-4. **Step C**, coarse: picks the stop angle ψ_f (a whole turn of the target angle ψ_t = 0,
-   at least ``stop_margin_turns`` ahead: the earliest whose stopping position
-   Z = z − κ(ψ − ψ_f) it can move to 0 at its largest speed before that stop less
-   ``stop_reserve_turns``) and moves Z within ``coarse_z_tol_m``, ending with the stopping
-   velocity V_s ~ 0 (Step C sets V_s with Step B); if it is still at it
+3. **transfer, with Step C alongside**: Step D's velocity sequences take x–y to the aim
+   point at rest (their stop angle set far ahead, never reached) while Step C moves the
+   stopping position Z = z − κ(ψ − ψ_f) to 0 within ``z_tol_m`` and ends with the
+   stopping velocity V_s ~ 0. The two do not disturb each other: the axis-III torque
+   leaves V_s and Z as they are (eqs. 21–22) and Step C's kicks leave the x–y velocity
+   unchanged to first order; Step D waits during a kick (and re-plans a sequence whose
+   start angle the kick passed), Step C during a velocity sequence. The stop angle ψ_f
+   (a whole turn of the target angle ψ_t = 0) is chosen at the transfer's start: the
+   earliest, at least the transfer's expected turns plus ``stop_reserve_turns`` ahead,
+   whose Z can reach 0 before that stop less the reserve, riding the stopping velocity
+   Step A left when it carries Z there in time (no kick to go), else at Step C's largest
+   speed (:func:`.step_c.choose_stop_turn`). With κ = 0.285 m the body moves 2πκ = 1.8 m
+   in z a turn while it spins, so Z must move tens of metres: done alongside the
+   transfer's hundreds of seconds, not after them. If Step C is still moving Z
    ``final_reserve_turns`` before the stop, it picks a later stop;
-5. **Step D** re-trims x–y; at the aim point at rest, a last, fine **Step C** (small kicks);
-   then Step D stops the spin on ψ_f. If Step D has to stop a turn later (ψ_f − 2π), Z
-   changed by 2πκ: back to a coarse Step C for that angle.
+4. **Step D** waits at the aim point and stops the spin on ψ_f with its final turn. If
+   Step D has to stop a turn later (ψ_f − 2π), Z changed by 2πκ: a coarse Step C
+   (``coarse_z_tol_m``) for that angle, Step D's re-trim and a fine Step C follow.
 Every switch is kept with its time (:attr:`Supervisor.switches`) for the run's summary.
-Legs 1–4 work on the test plant; leg 5 does not converge yet (docs/reproductions.md).
+From rest at seed 004's three cases it ends at rest on the target on the test plant
+(docs/reproductions.md).
 
 Inputs per cycle: time [s], ``q_BR`` (body relative to the target frame), ``omega_BN_B``
 [rad/s], position and velocity in the target frame [m, m/s]. Output: the torque demand
@@ -38,18 +46,19 @@ from flight_sw.control.underactuated.invariants import (
     TWO_PI,
     planned_stop_turn,
     spin_angle_rad,
+    stopping_velocity_m_s,
     unwrap,
 )
 from flight_sw.control.underactuated.step_a import StepA, StepAParams, in_single_spin
+from flight_sw.control.underactuated.step_b import Phase as PhaseB
 from flight_sw.control.underactuated.step_b import StepB, StepBParams
 from flight_sw.control.underactuated.step_c import Phase as PhaseC
-from flight_sw.control.underactuated.step_c import StepC, StepCParams
+from flight_sw.control.underactuated.step_c import StepC, StepCParams, choose_stop_turn
 from flight_sw.control.underactuated.step_d import Phase as PhaseD
 from flight_sw.control.underactuated.step_d import StepD, StepDParams
 
 _SOURCE = "[flight_sw.pose] underactuated"
 FAR_TURNS = 10_000  # the transfer's stop angle: never reached
-MAX_EXTRA_TURNS = 200  # Step C's search for a stop turn it can reach
 
 
 class Mode(enum.Enum):
@@ -74,10 +83,11 @@ class SupervisorParams:
     step_d: StepDParams = field(default_factory=StepDParams)
     single_spin_tilt_rad: float = math.radians(0.05)
     single_spin_rate_rad_s: float = 1e-4
-    stop_margin_turns: int = 16
-    stop_reserve_turns: float = 10.0
+    stop_margin_turns: int = 24
+    stop_reserve_turns: float = 20.0
     final_reserve_turns: float = 2.0
     coarse_z_tol_m: float = 0.3
+    z_tol_m: float = 0.0075
     drift_tol_m_s: float = 2e-3
 
     def __post_init__(self) -> None:
@@ -85,6 +95,7 @@ class SupervisorParams:
         check.positive(_SOURCE, "single_spin_rate_rad_s", self.single_spin_rate_rad_s)
         check.positive(_SOURCE, "drift_tol_m_s", self.drift_tol_m_s)
         check.positive(_SOURCE, "coarse_z_tol_m", self.coarse_z_tol_m)
+        check.positive(_SOURCE, "z_tol_m", self.z_tol_m)
         check.integer(_SOURCE, "stop_margin_turns", self.stop_margin_turns, lo=3)
         check.number(_SOURCE, "stop_reserve_turns", self.stop_reserve_turns, 2.0,
                      float(self.stop_margin_turns))
@@ -105,7 +116,7 @@ class Supervisor:
         self.step_c = StepC(self.step_b, params.step_c, period_s)
         self.step_d = StepD(thrusters, params.step_d, period_s)
         self.mode = Mode.A
-        self.fine = False  # Step C's last, fine round (after the x–y transfer)
+        self.fine = False  # Step C's tolerance is z_tol_m (else coarse_z_tol_m)
         self.psi_rad = 0.0
         #: (time [s], mode entered) for every switch
         self.switches: list[tuple[float, str]] = [(0.0, Mode.A.value)]
@@ -119,22 +130,40 @@ class Supervisor:
         """A stop angle so far ahead that it is never reached (the transfer's)."""
         return TWO_PI * planned_stop_turn(psi_rad, 0.0, FAR_TURNS * TWO_PI)
 
-    def _start_c(self, t_s: float, z_m: float, w3: float, first_turn: int) -> None:
-        """Step C for the earliest stop turn, from ``first_turn`` on, whose stopping position
-        it can move to 0 at its largest speed in the time left before that turn's final
-        turn (less the reserve); the later the stop, the farther Z is (2πκ a turn) but the
-        longer the time, so a speed above κ|ω_III| always finds one."""
-        kappa, w = self.thr.kappa_m_s_per_rad_s, max(abs(w3), 1e-9)
-        n = first_turn
-        for n in range(first_turn, first_turn - MAX_EXTRA_TURNS, -1):
-            psi_f = TWO_PI * n
-            left_s = (self.psi_rad - psi_f - self.p.stop_reserve_turns * TWO_PI) / w
-            z_stop = z_m - kappa * (self.psi_rad - psi_f)
-            if left_s > 0.0 and abs(z_stop) <= self.p.step_c.max_speed_m_s * left_s:
-                break
-        self.step_c.start(TWO_PI * n, self.p.stop_reserve_turns, self.p.coarse_z_tol_m)
-        self.fine = False
-        self._switch(t_s, Mode.C)
+    def _transfer_turns(self, w3: float, r_xy: np.ndarray) -> float:
+        """The turns the x–y transfer is expected to take: the distance to the aim point
+        at the transfer speed, plus a lead time at each end [turns]."""
+        dp = self.step_d.p
+        dist_m = float(np.linalg.norm(self.step_d.aim_m() - r_xy))
+        time_s = dist_m / dp.max_transfer_speed_m_s + 2.0 * self.step_d.lead_s(w3)
+        return abs(w3) * time_s / TWO_PI
+
+    def _start_c(self, t_s: float, z_m: float, w3: float, v_stop_m_s: float,
+                 first_turn: int, mode: Mode) -> None:
+        """Step C toward the stop turn :func:`.step_c.choose_stop_turn` picks from
+        ``first_turn`` on, ``stop_reserve_turns`` kept."""
+        n, move_s = choose_stop_turn(self.psi_rad, z_m, w3, v_stop_m_s,
+                                     self.thr.kappa_m_s_per_rad_s, first_turn,
+                                     self.p.stop_reserve_turns, self.p.step_c.max_speed_m_s)
+        # alongside the transfer Step C goes to its own (fine) tolerance: the transfer
+        # re-trims x–y after each of its rounds
+        fine = mode is Mode.TRANSFER
+        self.step_c.start(TWO_PI * n, self.p.stop_reserve_turns,
+                          self.p.z_tol_m if fine else self.p.coarse_z_tol_m, move_s)
+        self.fine = fine
+        self._switch(t_s, mode)
+
+    def _replan_if_late(self, t_s: float, z_m: float, w3: float, v_z: float) -> None:
+        """A later stop if Step C is still moving Z ``final_reserve_turns`` before it."""
+        c = self.step_c
+        done = c.phase is PhaseC.CHECK and abs(c.z_stop_m(z_m, self.psi_rad)) <= c.tol_m
+        if (c.phase in (PhaseC.CHECK, PhaseC.COAST) and not done
+                and self.psi_rad - c.psi_f_rad < self.p.final_reserve_turns * TWO_PI):
+            self._start_c(t_s, z_m, w3, self._v_stop(v_z, w3), planned_stop_turn(
+                self.psi_rad, 0.0, self.p.stop_margin_turns * TWO_PI), self.mode)
+
+    def _v_stop(self, v_z_m_s: float, w3: float) -> float:
+        return stopping_velocity_m_s(v_z_m_s, w3, self.thr.kappa_m_s_per_rad_s)
 
     def torque_B_Nm(self, t_s: float, q_BR: np.ndarray, omega_BN_B: np.ndarray,
                     r_R_m: np.ndarray, v_R_m_s: np.ndarray) -> np.ndarray:
@@ -154,23 +183,37 @@ class Supervisor:
             if (self.step_d.phase is PhaseD.COAST
                     and float(np.linalg.norm(v_R_m_s[:2])) <= self.p.drift_tol_m_s):
                 self.step_d.start(self._far(psi))
-                self._switch(t_s, Mode.TRANSFER)
+                turns = self._transfer_turns(w3, r_R_m[:2]) + self.p.stop_reserve_turns
+                self._start_c(t_s, float(r_R_m[2]), w3, self._v_stop(float(v_R_m_s[2]), w3),
+                              planned_stop_turn(psi, 0.0, turns * TWO_PI), Mode.TRANSFER)
             else:
                 t3 = self.step_d.torque_III_Nm(psi, w3, r_R_m[:2], v_R_m_s[:2])
                 return hold.track(omega_BN_B, hold.pointing_rate(q_BR), t3)
         if self.mode is Mode.TRANSFER:
-            if (self.step_d.phase is PhaseD.COAST
+            # Step C moves Z while Step D moves x–y (module docstring): Step D waits
+            # during a kick, Step C during a velocity sequence
+            self._replan_if_late(t_s, float(r_R_m[2]), w3, float(v_R_m_s[2]))
+            if (self.step_c.phase is not PhaseC.DONE
+                    and self.step_d.phase is not PhaseD.VELOCITY):
+                torque = self.step_c.torque_B_Nm(t_s, q_BR, omega_BN_B, psi, float(r_R_m[2]),
+                                                 float(v_R_m_s[2]))
+                if (self.step_c.phase in (PhaseC.GO, PhaseC.STOP)
+                        and self.step_b.phase is not PhaseB.SETTLE):
+                    return torque  # a kick: Step D waits
+            seq = self.step_d.sequence
+            if (self.step_d.phase is PhaseD.COAST and seq is not None
+                    and psi < seq.psi_a_rad - abs(w3) * self.period_s):
+                self.step_d.start(self._far(psi))  # a kick passed its start angle: re-plan
+            if not (self.step_d.phase is PhaseD.COAST
                     and self.step_d.settled(r_R_m[:2], v_R_m_s[:2])):
-                self._start_c(t_s, float(r_R_m[2]), w3, planned_stop_turn(
-                    psi, 0.0, self.p.stop_margin_turns * TWO_PI))
-            else:
                 t3 = self.step_d.torque_III_Nm(psi, w3, r_R_m[:2], v_R_m_s[:2])
                 return hold.track(omega_BN_B, hold.pointing_rate(q_BR), t3)
+            if self.step_c.phase is not PhaseC.DONE:
+                return hold.track(omega_BN_B, hold.pointing_rate(q_BR))  # Z still moving
+            self.step_d.start(self.step_c.psi_f_rad)
+            self._switch(t_s, Mode.D)
         if self.mode is Mode.C:
-            if (self.step_c.phase in (PhaseC.CHECK, PhaseC.COAST)
-                    and psi - self.step_c.psi_f_rad < self.p.final_reserve_turns * TWO_PI):
-                self._start_c(t_s, float(r_R_m[2]), w3, planned_stop_turn(
-                    psi, 0.0, self.p.stop_margin_turns * TWO_PI))  # too late: a later stop
+            self._replan_if_late(t_s, float(r_R_m[2]), w3, float(v_R_m_s[2]))
             torque = self.step_c.torque_B_Nm(t_s, q_BR, omega_BN_B, psi, float(r_R_m[2]),
                                              float(v_R_m_s[2]))
             if self.step_c.phase is not PhaseC.DONE:
@@ -179,18 +222,19 @@ class Supervisor:
             self._switch(t_s, Mode.D)
         if self.mode is Mode.D:
             psi_f = self.step_d.psi_f_rad
-            if (not self.fine and self.step_d.phase is PhaseD.COAST
-                    and self.step_d.settled(r_R_m[:2], v_R_m_s[:2])):
-                # at the aim point: the last, fine round of Step C (small kicks)
-                self.step_c.start(psi_f, self.step_c.p.reserve_turns)
+            waiting = (self.step_d.phase is PhaseD.COAST
+                       and self.step_d.settled(r_R_m[:2], v_R_m_s[:2]))
+            if not self.fine and waiting:
+                # after a coarse Step C, at the aim point: a fine round (small kicks)
+                self.step_c.start(psi_f, self.step_c.p.reserve_turns, self.p.z_tol_m)
                 self.fine = True
                 self._switch(t_s, Mode.C)
                 return self.step_c.torque_B_Nm(t_s, q_BR, omega_BN_B, psi, float(r_R_m[2]),
                                                float(v_R_m_s[2]))
             t3 = self.step_d.torque_III_Nm(psi, w3, r_R_m[:2], v_R_m_s[:2])
             if self.step_d.psi_f_rad != psi_f:  # a turn later: Z moved by 2πκ
-                self._start_c(t_s, float(r_R_m[2]), w3,
-                              round(self.step_d.psi_f_rad / TWO_PI))
+                self._start_c(t_s, float(r_R_m[2]), w3, self._v_stop(float(v_R_m_s[2]), w3),
+                              round(self.step_d.psi_f_rad / TWO_PI), Mode.C)
                 return hold.track(omega_BN_B, hold.pointing_rate(q_BR))
             if self.step_d.phase is PhaseD.DONE:
                 self._switch(t_s, Mode.DONE)

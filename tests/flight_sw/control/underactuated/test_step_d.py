@@ -88,6 +88,44 @@ def test_step_d_from_an_offset_and_drift() -> None:
     _assert_at_target(plant, thrusts)
 
 
+def test_lead_time_is_at_least_the_spin_periods() -> None:
+    """The transfer's lead is ``transfer_lead_s`` at a fast spin and ``lead_turns`` spin
+    periods at a slow one (a sequence waits up to a turn for its start)."""
+    p = StepDParams()
+    step_d = StepD(ref.vehicle(), p, ref.PERIOD_S)
+    fast = 2.0 * p.lead_turns * TWO_PI / p.transfer_lead_s  # rad/s: periods well inside
+    assert step_d.lead_s(-fast) == p.transfer_lead_s
+    slow = 0.05
+    assert step_d.lead_s(-slow) == pytest.approx(p.lead_turns * TWO_PI / slow)
+
+
+def test_a_small_offset_still_gets_a_sequence() -> None:
+    """An offset just outside the position tolerance, at rest, at a slow spin: the demanded
+    speed is above the velocity tolerance, so a sequence is planned (no dead band)."""
+    p = StepDParams()
+    step_d = StepD(ref.vehicle(), p, ref.PERIOD_S)
+    step_d.start(-1000 * TWO_PI)
+    r = step_d.aim_m() + np.array([1.5 * p.position_tol_m, 0.0])
+    w3 = -0.05
+    assert float(np.linalg.norm(step_d.aim_m() - r)) / step_d.lead_s(w3) < p.velocity_tol_m_s
+    step_d.torque_III_Nm(0.0, w3, r, np.zeros(2))
+    assert step_d.sequence is not None
+
+
+def test_a_final_turn_passed_unseen_moves_the_stop_a_turn_later() -> None:
+    """Called first after ψ_f + 2π has passed (settled there): no late final turn, the stop
+    moves down by whole turns until its final turn is ahead."""
+    step_d = StepD(ref.vehicle(), StepDParams(), ref.PERIOD_S)
+    psi_f = 0.0
+    step_d.start(psi_f)
+    psi = psi_f + 0.4 * TWO_PI  # 0.6 turn past the final turn's start
+    step_d.torque_III_Nm(psi, -0.1, step_d.aim_m(), np.zeros(2))
+    assert step_d.phase is not Phase.FINAL
+    moved = step_d.postponed_turns
+    assert moved >= 1 and step_d.psi_f_rad == psi_f - TWO_PI * moved
+    assert step_d.psi_f_rad + TWO_PI < psi
+
+
 def test_next_angle_below() -> None:
     """The next angle a negative spin reaches, equal to the given one mod 2π."""
     assert next_angle_below(10.0, 1.0) == pytest.approx(10.0 - ((10.0 - 1.0) % TWO_PI))
