@@ -10,6 +10,7 @@ backwards).
 from __future__ import annotations
 
 import threading
+import time
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
@@ -30,6 +31,7 @@ from flight_sw.node import HEARTBEAT_RETRY_S, FlightNode
 
 QUICKSTART = Path(__file__).resolve().parents[2] / "scenarios" / "quickstart.toml"
 RECV_TIMEOUT_S = 5.0
+COUNT_POLL_S = 0.001  # polling the node's counters until a deadline
 PERIOD_S = 0.02
 IMU_PER_CYCLE = 2
 SAFE_AFTER_CYCLES = 2  # 3 IMU periods (30 ms) of silence are over within 2 control cycles
@@ -146,6 +148,10 @@ def test_a_cycle_sends_status_first_and_commands_last(setup: tuple[FlightNode, B
         if d is not None:
             names.append(d.name)
     assert names == ["FSW_STATUS", "FSW_ATT_EST", "FSW_FDIR", "THR_CMD_0", "THR_CMD_1"]
+    # the node counts a burst once it is sent: the bench can hear it first
+    deadline = time.monotonic() + RECV_TIMEOUT_S
+    while "THR_CMD_1" not in node.stats.sent and time.monotonic() < deadline:
+        time.sleep(COUNT_POLL_S)
     assert node.stats.sent["THR_CMD_0"] == node.stats.sent["THR_CMD_1"] == 1
     assert node.stats.sent["FSW_STATUS"] == 2  # the boot heartbeat, then cycle 0's
 
