@@ -35,6 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from flight_sw.quaternion import skew
+from flight_sw.vec3 import Mat3, Vec3, vec3
 
 # |σ| above which :func:`switched` maps to the shadow set (σ and σˢ coincide at |σ| = 1).
 SHADOW_SWITCH_NORM_SQ = 1.0
@@ -83,11 +84,33 @@ def to_dcm(sigma: np.ndarray) -> np.ndarray:
     return np.eye(3) + (8.0 * sk @ sk - 4.0 * (1.0 - norm_sq) * sk) / (1.0 + norm_sq) ** 2
 
 
+def kinematics(s0: float, s1: float, s2: float) -> Mat3:
+    """``F(σ) = ¼[(1 − s) I + 2[σ×] + 2σσᵀ]`` on floats, row-major (seed 001 eq. (1)):
+    the one implementation (the flight software's per-cycle laws call it directly)."""
+    k = KINEMATICS_SCALE
+    a = 1.0 - (s0 * s0 + s1 * s1 + s2 * s2)
+    return (k * (a + 2.0 * s0 * s0), k * (2.0 * s0 * s1 - 2.0 * s2), k * (2.0 * s0 * s2 + 2.0 * s1),
+            k * (2.0 * s1 * s0 + 2.0 * s2), k * (a + 2.0 * s1 * s1), k * (2.0 * s1 * s2 - 2.0 * s0),
+            k * (2.0 * s2 * s0 - 2.0 * s1), k * (2.0 * s2 * s1 + 2.0 * s0), k * (a + 2.0 * s2 * s2))
+
+
+def kinematics_rate(s: Vec3, sd: Vec3) -> Mat3:
+    """``Ḟ(σ, σ̇) = ½[−(σᵀσ̇) I + [σ̇×] + σ̇σᵀ + σσ̇ᵀ]`` on floats, row-major."""
+    s0, s1, s2 = s
+    d0, d1, d2 = sd
+    dot = s0 * d0 + s1 * d1 + s2 * d2
+    return (0.5 * (2.0 * d0 * s0 - dot), 0.5 * (d0 * s1 + s0 * d1 - d2),
+            0.5 * (d0 * s2 + s0 * d2 + d1),
+            0.5 * (d1 * s0 + s1 * d0 + d2), 0.5 * (2.0 * d1 * s1 - dot),
+            0.5 * (d1 * s2 + s1 * d2 - d0),
+            0.5 * (d2 * s0 + s2 * d0 - d1), 0.5 * (d2 * s1 + s2 * d1 + d0),
+            0.5 * (2.0 * d2 * s2 - dot))
+
+
 def kinematics_matrix(sigma: np.ndarray) -> np.ndarray:
-    """``F(σ) = ¼[(1 − s) I + 2[σ×] + 2σσᵀ]`` with ``σ̇ = F(σ) ω`` (seed 001 eq. (1))."""
-    s = np.asarray(sigma, dtype=float)
-    norm_sq = float(s @ s)
-    return KINEMATICS_SCALE * ((1.0 - norm_sq) * np.eye(3) + 2.0 * skew(s) + 2.0 * np.outer(s, s))
+    """``F(σ)`` (:func:`kinematics`) as a 3×3 array, ``σ̇ = F(σ) ω``."""
+    s0, s1, s2 = np.asarray(sigma, dtype=float).tolist()
+    return np.array(kinematics(s0, s1, s2)).reshape(3, 3)
 
 
 def kinematics_matrix_inverse(sigma: np.ndarray) -> np.ndarray:
@@ -98,10 +121,10 @@ def kinematics_matrix_inverse(sigma: np.ndarray) -> np.ndarray:
 
 
 def kinematics_matrix_rate(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
-    """``Ḟ(σ, σ̇) = ½[−(σᵀσ̇) I + [σ̇×] + σ̇σᵀ + σσ̇ᵀ]``, the time derivative of ``F(σ(t))``."""
-    s = np.asarray(sigma, dtype=float)
-    sd = np.asarray(sigma_dot, dtype=float)
-    return 0.5 * (-float(s @ sd) * np.eye(3) + skew(sd) + np.outer(sd, s) + np.outer(s, sd))
+    """``Ḟ(σ, σ̇)`` (:func:`kinematics_rate`) as a 3×3 array: the derivative of ``F(σ(t))``."""
+    s = vec3(np.asarray(sigma, dtype=float))
+    sd = vec3(np.asarray(sigma_dot, dtype=float))
+    return np.array(kinematics_rate(s, sd)).reshape(3, 3)
 
 
 def rate_to_omega(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:

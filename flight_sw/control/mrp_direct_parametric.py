@@ -50,8 +50,8 @@ from scipy.linalg import block_diag
 from dbc import validation as check
 from dbc.errors import ConfigError
 from flight_sw import mrp
-from flight_sw.quaternion import cross as cross3
 from flight_sw.quaternion import error_quaternion
+from flight_sw.vec3 import Vec3, cross, mat3, mat_t_vec, mat_vec, vec3
 
 N_AXES = 3
 N_STATES = 2 * N_AXES
@@ -132,9 +132,10 @@ class MrpDirectParametric:
         z = np.array(params.z)
         v_inv = np.linalg.inv(params.v_matrix())
         # K0 ε + K1 ε̇ = H (Z F0² V⁻¹ X) + C (Z F0 V⁻¹ X), from eq. (10)–(11).
-        self._zf0sq_vinv = z @ f0 @ f0 @ v_inv
-        self._zf0_vinv = z @ f0 @ v_inv
+        self._zf0sq_vinv_t = tuple((z @ f0 @ f0 @ v_inv).reshape(-1).tolist())
+        self._zf0_vinv_t = tuple((z @ f0 @ v_inv).reshape(-1).tolist())
         self._inertia = check.inertia("MrpDirectParametric", "inertia_B_kgm2", inertia_B_kgm2)
+        self._j = mat3(self._inertia)
 
     @property
     def params(self) -> MrpDirectParametricParams:
@@ -149,6 +150,7 @@ class MrpDirectParametric:
     def set_inertia_B_kgm2(self, inertia_B_kgm2: np.ndarray) -> None:
         """Use ``inertia_B_kgm2`` (3×3, symmetric positive definite) from now on."""
         self._inertia = check.inertia("MrpDirectParametric", "inertia_B_kgm2", inertia_B_kgm2)
+        self._j = mat3(self._inertia)
 
     def torque_B_Nm(
         self,
@@ -159,20 +161,44 @@ class MrpDirectParametric:
         omega_RN_B: np.ndarray,
         domega_RN_B: np.ndarray | None = None,
     ) -> np.ndarray:
-        """``τ_B = n + Fᵀ(ε)(K0 ε + K1 ε̇)`` [N m] (module docstring)."""
-        j = self._inertia
-        omega = np.asarray(omega_BN_B, dtype=float)
-        omega_ref = np.asarray(omega_RN_B, dtype=float)
-        omega_err = omega - omega_ref
-        eps = mrp.from_quaternion(error_quaternion(q_RN, q_BN))
-        f = mrp.kinematics_matrix(eps)
-        eps_dot = f @ omega_err
-        g = mrp.kinematics_matrix_inverse(eps)
-        h = g.T @ j @ g
-        c = -h @ mrp.kinematics_matrix_rate(eps, eps_dot) @ g
-        x = np.concatenate((eps, eps_dot))
-        generalised_Nm = h @ (self._zf0sq_vinv @ x) + c @ (self._zf0_vinv @ x)
-        n = cross3(omega, j @ omega) - j @ cross3(omega_err, omega_ref)
+        """``τ_B = n + Fᵀ(ε)(K0 ε + K1 ε̇)`` [N m] (module docstring), on floats: with
+        ``H = GᵀJG`` and ``C = −H Ḟ G``, ``K0 ε + K1 ε̇ = H (a − Ḟ G b)`` for
+        ``a = Z F0² V⁻¹ X`` and ``b = Z F0 V⁻¹ X``."""
+        j = self._j
+        w = vec3(omega_BN_B)
+        wr = vec3(omega_RN_B)
+        we = (w[0] - wr[0], w[1] - wr[1], w[2] - wr[2])
+        q0, q1, q2, q3 = error_quaternion(q_RN, q_BN).tolist()
+        if q0 < 0.0:  # the short way (mrp.from_quaternion)
+            q0, q1, q2, q3 = -q0, -q1, -q2, -q3
+        e0, e1, e2 = q1 / (1.0 + q0), q2 / (1.0 + q0), q3 / (1.0 + q0)
+        f = mrp.kinematics(e0, e1, e2)
+        ed = mat_vec(f, we[0], we[1], we[2])
+        g_scale = mrp.INVERSE_SCALE / (1.0 + (e0 * e0 + e1 * e1 + e2 * e2)) ** 2
+        x = (e0, e1, e2, ed[0], ed[1], ed[2])
+        a = _times6(self._zf0sq_vinv_t, x)
+        b = _times6(self._zf0_vinv_t, x)
+        gb = mat_t_vec(f, g_scale * b[0], g_scale * b[1], g_scale * b[2])  # G = s Fᵀ
+        fdot_gb = mat_vec(mrp.kinematics_rate((e0, e1, e2), ed), gb[0], gb[1], gb[2])
+        u = (a[0] - fdot_gb[0], a[1] - fdot_gb[1], a[2] - fdot_gb[2])
+        gu = mat_t_vec(f, g_scale * u[0], g_scale * u[1], g_scale * u[2])
+        jgu = mat_vec(j, gu[0], gu[1], gu[2])
+        hu = mat_vec(f, g_scale * jgu[0], g_scale * jgu[1], g_scale * jgu[2])  # Gᵀ = s F
+        jw = mat_vec(j, w[0], w[1], w[2])
+        gyro = cross(w, jw)
+        jx = mat_vec(j, *cross(we, wr))
+        n = [gyro[0] - jx[0], gyro[1] - jx[1], gyro[2] - jx[2]]
         if domega_RN_B is not None:
-            n = n + j @ np.asarray(domega_RN_B, dtype=float)
-        return np.asarray(n + f.T @ generalised_Nm)
+            jd = mat_vec(j, *vec3(domega_RN_B))
+            n = [n[0] + jd[0], n[1] + jd[1], n[2] + jd[2]]
+        ft = mat_t_vec(f, hu[0], hu[1], hu[2])
+        return np.array((n[0] + ft[0], n[1] + ft[1], n[2] + ft[2]))
+
+
+def _times6(m: tuple[float, ...], x: tuple[float, ...]) -> Vec3:
+    """A 3×6 row-major matrix times a 6-vector."""
+    out = [0.0, 0.0, 0.0]
+    for i in range(N_AXES):
+        row = m[N_STATES * i:N_STATES * (i + 1)]
+        out[i] = sum(r * v for r, v in zip(row, x, strict=True))
+    return (out[0], out[1], out[2])
