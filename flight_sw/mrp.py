@@ -60,12 +60,23 @@ def switched(sigma: np.ndarray) -> np.ndarray:
     return shadow(s) if float(s @ s) > SHADOW_SWITCH_NORM_SQ else s.copy()
 
 
+def from_quaternion_f(q0: float, q1: float, q2: float, q3: float) -> Vec3:
+    """``σ = q_vec / (1 + q0)`` on floats, of ``q`` or ``−q`` whichever has ``q0 ≥ 0``
+    (``|σ| ≤ 1``: the short way)."""
+    if q0 < 0.0:
+        q0, q1, q2, q3 = -q0, -q1, -q2, -q3
+    return (q1 / (1.0 + q0), q2 / (1.0 + q0), q3 / (1.0 + q0))
+
+
 def from_quaternion(q: np.ndarray) -> np.ndarray:
     """The MRP of the unit quaternion ``q`` with ``|σ| ≤ 1`` (``q`` and ``−q`` agree)."""
-    qa = np.asarray(q, dtype=float)
-    if qa[0] < 0.0:
-        qa = -qa
-    return qa[1:] / (1.0 + qa[0])
+    q0, q1, q2, q3 = np.asarray(q, dtype=float).tolist()
+    return np.array(from_quaternion_f(q0, q1, q2, q3))
+
+
+def inverse_factor(norm_sq: float) -> float:
+    """``16/(1 + s)²``: ``F⁻¹(σ) = 16/(1 + s)² F(σ)ᵀ`` for ``s = σᵀσ``."""
+    return INVERSE_SCALE / (1.0 + norm_sq) ** 2
 
 
 def to_quaternion(sigma: np.ndarray) -> np.ndarray:
@@ -116,8 +127,7 @@ def kinematics_matrix(sigma: np.ndarray) -> np.ndarray:
 def kinematics_matrix_inverse(sigma: np.ndarray) -> np.ndarray:
     """``G(σ) = F⁻¹(σ) = 16/(1 + s)² F(σ)ᵀ``, so ``ω = G(σ) σ̇`` (seed 001)."""
     s = np.asarray(sigma, dtype=float)
-    norm_sq = float(s @ s)
-    return INVERSE_SCALE / (1.0 + norm_sq) ** 2 * kinematics_matrix(s).T
+    return inverse_factor(float(s @ s)) * kinematics_matrix(s).T
 
 
 def kinematics_matrix_rate(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
@@ -142,6 +152,6 @@ def omega_and_rate(sigma: np.ndarray, sigma_dot: np.ndarray, sigma_ddot: np.ndar
     norm_sq = float(s @ s)
     s_dot = 2.0 * float(s @ sd)
     g = kinematics_matrix_inverse(s)
-    g_dot = (INVERSE_SCALE / (1.0 + norm_sq) ** 2 * kinematics_matrix_rate(s, sd).T
+    g_dot = (inverse_factor(norm_sq) * kinematics_matrix_rate(s, sd).T
              - 2.0 * s_dot / (1.0 + norm_sq) * g)
     return g @ sd, g_dot @ sd + g @ sdd

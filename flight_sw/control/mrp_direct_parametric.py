@@ -169,12 +169,10 @@ class MrpDirectParametric:
         wr = vec3(omega_RN_B)
         we = (w[0] - wr[0], w[1] - wr[1], w[2] - wr[2])
         q0, q1, q2, q3 = error_quaternion(q_RN, q_BN).tolist()
-        if q0 < 0.0:  # the short way (mrp.from_quaternion)
-            q0, q1, q2, q3 = -q0, -q1, -q2, -q3
-        e0, e1, e2 = q1 / (1.0 + q0), q2 / (1.0 + q0), q3 / (1.0 + q0)
+        e0, e1, e2 = mrp.from_quaternion_f(q0, q1, q2, q3)
         f = mrp.kinematics(e0, e1, e2)
         ed = mat_vec(f, we[0], we[1], we[2])
-        g_scale = mrp.INVERSE_SCALE / (1.0 + (e0 * e0 + e1 * e1 + e2 * e2)) ** 2
+        g_scale = mrp.inverse_factor(e0 * e0 + e1 * e1 + e2 * e2)
         x = (e0, e1, e2, ed[0], ed[1], ed[2])
         a = _times6(self._zf0sq_vinv_t, x)
         b = _times6(self._zf0_vinv_t, x)

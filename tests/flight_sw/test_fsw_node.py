@@ -149,9 +149,11 @@ def test_a_cycle_sends_status_first_and_commands_last(setup: tuple[FlightNode, B
             names.append(d.name)
     assert names == ["FSW_STATUS", "FSW_ATT_EST", "FSW_FDIR", "THR_CMD_0", "THR_CMD_1"]
     # the node counts a burst once it is sent: the bench can hear it first
+    expected = len(names) + 1  # and the boot heartbeat
     deadline = time.monotonic() + RECV_TIMEOUT_S
-    while "THR_CMD_1" not in node.stats.sent and time.monotonic() < deadline:
+    while sum(node.stats.sent.values()) < expected and time.monotonic() < deadline:
         time.sleep(COUNT_POLL_S)
+    assert sum(node.stats.sent.values()) == expected, f"counted {node.stats.sent}"
     assert node.stats.sent["THR_CMD_0"] == node.stats.sent["THR_CMD_1"] == 1
     assert node.stats.sent["FSW_STATUS"] == 2  # the boot heartbeat, then cycle 0's
 

@@ -28,6 +28,7 @@ import numpy as np
 from flight_sw.quaternion import to_dcm
 
 TWO_PI = 2.0 * math.pi
+SPIN_FLOOR_RAD_S = 1e-9  # |ω_III| below this is taken as this in times to an angle
 
 
 def target_z_in_B(q_BR: np.ndarray) -> np.ndarray:

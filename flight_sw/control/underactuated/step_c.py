@@ -34,7 +34,11 @@ import numpy as np
 
 from dbc import validation as check
 from flight_sw.control.underactuated.disturbance import plan_kick
-from flight_sw.control.underactuated.invariants import TWO_PI, stopping_position_m
+from flight_sw.control.underactuated.invariants import (
+    SPIN_FLOOR_RAD_S,
+    TWO_PI,
+    stopping_position_m,
+)
 from flight_sw.control.underactuated.step_b import Phase as PhaseB
 from flight_sw.control.underactuated.step_b import StepB
 
@@ -50,10 +54,12 @@ def choose_stop_turn(psi_rad: float, z_m: float, omega_III_rad_s: float,
     negative spin) for Step C: the earliest whose stopping position Z_n = z − κ(ψ − 2πn)
     can reach 0 in the time left before that stop less ``reserve_turns``, carried there by
     the stopping velocity the body already has (no kick to go: returned with its move time
-    −Z_n/V_s [s]) or else at ``max_speed_m_s`` (move time None: Step C's own). The later
-    the stop, the farther Z_n (2πκ a turn) but the longer the time, so a speed above
-    κ|ω_III| always finds one; ``max_extra_turns`` bounds the search."""
-    w = max(abs(omega_III_rad_s), 1e-9)
+    −Z_n/V_s [s]) or else at ``max_speed_m_s`` (move time None: Step C's own). Z_n falls
+    by 2πκ a turn later while the time grows by 2π/|ω_III|, so a speed above κ|ω_III|
+    always finds one; past ``max_extra_turns`` the last turn tried is returned (move time
+    None: Step C then moves Z at its largest speed and the supervisor's late check
+    follows)."""
+    w = max(abs(omega_III_rad_s), SPIN_FLOOR_RAD_S)
     n = first_turn
     for n in range(first_turn, first_turn - max_extra_turns, -1):
         left_s = (psi_rad - TWO_PI * n - reserve_turns * TWO_PI) / w
@@ -160,7 +166,7 @@ class StepC:
             if abs(z_stop) <= self.tol_m:
                 self.phase = Phase.DONE
             else:
-                w = max(abs(float(omega_BN_B[2])), 1e-9)
+                w = max(abs(float(omega_BN_B[2])), SPIN_FLOOR_RAD_S)
                 first = self.rounds == 0
                 reserve = self.reserve_turns if first else self.p.reserve_turns
                 move_s = self.move_time_s if first else self.p.move_time_s

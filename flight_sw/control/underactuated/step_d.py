@@ -43,6 +43,7 @@ from flight_sw.control.underactuated.despin import (
     max_half_turn_dv,
 )
 from flight_sw.control.underactuated.geometry import ThreeThrusters
+from flight_sw.control.underactuated.invariants import SPIN_FLOOR_RAD_S
 
 _SOURCE = "[flight_sw.pose] step D"
 MIN_SPEED_TOLS = 2.0  # the least transfer speed, in velocity tolerances
@@ -127,7 +128,8 @@ class StepD:
         """The transfer's lead time: ``transfer_lead_s``, or ``lead_turns`` spin periods if
         longer (a sequence waits up to a turn for its start angle and lasts half a turn:
         a lead shorter than that overshoots and rings as the spin slows) [s]."""
-        return max(self.p.transfer_lead_s, self.p.lead_turns * TWO_PI / max(abs(w3), 1e-9))
+        return max(self.p.transfer_lead_s, self.p.lead_turns * TWO_PI
+                   / max(abs(w3), SPIN_FLOOR_RAD_S))
 
     def _transfer_velocity(self, r_from: np.ndarray, w3: float) -> np.ndarray:
         """The x–y velocity that closes the gap to the aim point in the transfer lead time

@@ -18,10 +18,12 @@ What it does (seed 004 §3.1, Figure 3, with the x–y transfer made a step of i
    speed (:func:`.step_c.choose_stop_turn`). With κ = 0.285 m the body moves 2πκ = 1.8 m
    in z a turn while it spins, so Z must move tens of metres: done alongside the
    transfer's hundreds of seconds, not after them. If Step C is still moving Z
-   ``final_reserve_turns`` before the stop, it picks a later stop;
+   ``final_reserve_turns`` before the stop, or finds no time left for a round with Z
+   outside its tolerance, a later stop is picked (Step C's own reserve kept);
 4. **Step D** waits at the aim point and stops the spin on ψ_f with its final turn. If
    Step D has to stop a turn later (ψ_f − 2π), Z changed by 2πκ: a coarse Step C
-   (``coarse_z_tol_m``) for that angle, Step D's re-trim and a fine Step C follow.
+   (``coarse_z_tol_m``) toward the earliest turn from that one it can reach with its own
+   reserve, Step D's re-trim and a fine Step C follow (a fallback: no case takes it).
 Every switch is kept with its time (:attr:`Supervisor.switches`) for the run's summary.
 From rest at seed 004's three cases it ends at rest on the target on the test plant
 (docs/reproductions.md).
@@ -59,6 +61,8 @@ from flight_sw.control.underactuated.step_d import StepD, StepDParams
 
 _SOURCE = "[flight_sw.pose] underactuated"
 FAR_TURNS = 10_000  # the transfer's stop angle: never reached
+MAX_RESERVE_TURNS = 200.0  # a reserve beyond this is a configuration error
+LATER_STOP_EXTRA_TURNS = 2.0  # a later stop: Step C's reserve plus these turns ahead
 
 
 class Mode(enum.Enum):
@@ -74,8 +78,10 @@ class Mode(enum.Enum):
 
 @dataclass(frozen=True)
 class SupervisorParams:
-    """Each step's parameters; single-spin tolerances [rad, rad/s]; turns kept between
-    Step C's start and the stop."""
+    """Each step's parameters; single-spin tolerances [rad, rad/s]; turns kept after the
+    transfer's expected end before the stop, and the turns before the stop at which a
+    Step C still moving Z picks a later one; Z tolerances [m] (coarse: after a later stop
+    was picked; fine: alongside the transfer); the drift left by Step A [m/s]."""
 
     step_a: StepAParams = field(default_factory=StepAParams)
     step_b: StepBParams = field(default_factory=StepBParams)
@@ -83,7 +89,6 @@ class SupervisorParams:
     step_d: StepDParams = field(default_factory=StepDParams)
     single_spin_tilt_rad: float = math.radians(0.05)
     single_spin_rate_rad_s: float = 1e-4
-    stop_margin_turns: int = 24
     stop_reserve_turns: float = 20.0
     final_reserve_turns: float = 2.0
     coarse_z_tol_m: float = 0.3
@@ -96,9 +101,8 @@ class SupervisorParams:
         check.positive(_SOURCE, "drift_tol_m_s", self.drift_tol_m_s)
         check.positive(_SOURCE, "coarse_z_tol_m", self.coarse_z_tol_m)
         check.positive(_SOURCE, "z_tol_m", self.z_tol_m)
-        check.integer(_SOURCE, "stop_margin_turns", self.stop_margin_turns, lo=3)
         check.number(_SOURCE, "stop_reserve_turns", self.stop_reserve_turns, 2.0,
-                     float(self.stop_margin_turns))
+                     MAX_RESERVE_TURNS)
         check.number(_SOURCE, "final_reserve_turns", self.final_reserve_turns, 1.0,
                      self.stop_reserve_turns)
 
@@ -139,28 +143,36 @@ class Supervisor:
         return abs(w3) * time_s / TWO_PI
 
     def _start_c(self, t_s: float, z_m: float, w3: float, v_stop_m_s: float,
-                 first_turn: int, mode: Mode) -> None:
+                 first_turn: int, mode: Mode, reserve_turns: float | None = None) -> None:
         """Step C toward the stop turn :func:`.step_c.choose_stop_turn` picks from
-        ``first_turn`` on, ``stop_reserve_turns`` kept."""
+        ``first_turn`` on, ``reserve_turns`` kept (default ``stop_reserve_turns``: the
+        transfer's start; a later stop keeps Step C's own reserve)."""
+        reserve = self.p.stop_reserve_turns if reserve_turns is None else reserve_turns
         n, move_s = choose_stop_turn(self.psi_rad, z_m, w3, v_stop_m_s,
-                                     self.thr.kappa_m_s_per_rad_s, first_turn,
-                                     self.p.stop_reserve_turns, self.p.step_c.max_speed_m_s)
+                                     self.thr.kappa_m_s_per_rad_s, first_turn, reserve,
+                                     self.p.step_c.max_speed_m_s)
         # alongside the transfer Step C goes to its own (fine) tolerance: the transfer
         # re-trims x–y after each of its rounds
         fine = mode is Mode.TRANSFER
-        self.step_c.start(TWO_PI * n, self.p.stop_reserve_turns,
-                          self.p.z_tol_m if fine else self.p.coarse_z_tol_m, move_s)
+        self.step_c.start(TWO_PI * n, reserve, self.p.z_tol_m if fine else self.p.coarse_z_tol_m,
+                          move_s)
         self.fine = fine
-        self._switch(t_s, mode)
+        if mode is not self.mode:
+            self._switch(t_s, mode)
 
     def _replan_if_late(self, t_s: float, z_m: float, w3: float, v_z: float) -> None:
-        """A later stop if Step C is still moving Z ``final_reserve_turns`` before it."""
+        """A later stop if Step C is still moving Z ``final_reserve_turns`` before it, or
+        found no time left for a round with Z outside its tolerance (``out_of_turns``):
+        the first turn that leaves Step C its reserve and the final turn."""
         c = self.step_c
-        done = c.phase is PhaseC.CHECK and abs(c.z_stop_m(z_m, self.psi_rad)) <= c.tol_m
-        if (c.phase in (PhaseC.CHECK, PhaseC.COAST) and not done
-                and self.psi_rad - c.psi_f_rad < self.p.final_reserve_turns * TWO_PI):
+        z_off = abs(c.z_stop_m(z_m, self.psi_rad)) > c.tol_m
+        late = (c.phase in (PhaseC.CHECK, PhaseC.COAST) and z_off
+                and self.psi_rad - c.psi_f_rad < self.p.final_reserve_turns * TWO_PI)
+        if late or (c.phase is PhaseC.DONE and c.out_of_turns and z_off):
+            reserve = c.p.reserve_turns
             self._start_c(t_s, z_m, w3, self._v_stop(v_z, w3), planned_stop_turn(
-                self.psi_rad, 0.0, self.p.stop_margin_turns * TWO_PI), self.mode)
+                self.psi_rad, 0.0, (reserve + LATER_STOP_EXTRA_TURNS) * TWO_PI), self.mode,
+                reserve)
 
     def _v_stop(self, v_z_m_s: float, w3: float) -> float:
         return stopping_velocity_m_s(v_z_m_s, w3, self.thr.kappa_m_s_per_rad_s)
@@ -234,7 +246,8 @@ class Supervisor:
             t3 = self.step_d.torque_III_Nm(psi, w3, r_R_m[:2], v_R_m_s[:2])
             if self.step_d.psi_f_rad != psi_f:  # a turn later: Z moved by 2πκ
                 self._start_c(t_s, float(r_R_m[2]), w3, self._v_stop(float(v_R_m_s[2]), w3),
-                              round(self.step_d.psi_f_rad / TWO_PI), Mode.C)
+                              round(self.step_d.psi_f_rad / TWO_PI), Mode.C,
+                              self.step_c.p.reserve_turns)
                 return hold.track(omega_BN_B, hold.pointing_rate(q_BR))
             if self.step_d.phase is PhaseD.DONE:
                 self._switch(t_s, Mode.DONE)

@@ -13,6 +13,7 @@ from flight_sw.control.underactuated.invariants import (
     unwrap,
 )
 from flight_sw.control.underactuated.step_a import StepA, StepAParams
+from flight_sw.control.underactuated.step_b import Phase as PhaseB
 from flight_sw.control.underactuated.step_b import StepB, StepBParams
 from flight_sw.control.underactuated.step_c import Phase, StepC, StepCParams, choose_stop_turn
 from tests.flight_sw.control.underactuated import ffrb_reference as ref
@@ -95,6 +96,18 @@ def test_stop_turn_rides_the_drift_it_has(v_stop_m_s: float) -> None:
     assert move_s <= _left_s(psi, n)
 
 
+@pytest.mark.parametrize("v_stop_m_s", [0.005, 0.1])
+def test_stop_turn_does_not_ride_a_drift_too_slow_or_too_fast(v_stop_m_s: float) -> None:
+    """Z_n of the sign the drift closes, but the drift too slow to close it in time
+    (5 mm/s) or faster than Step C's largest speed (0.1 m/s): Step C's own speed."""
+    psi, first = 3.0, -10
+    z = _z_for(psi, -10.0, first)
+    n, move_s = choose_stop_turn(psi, z, SPIN_CHOICE_RAD_S, v_stop_m_s, KAPPA_M, first,
+                                 RESERVE_TURNS, MAX_SPEED_M_S)
+    assert move_s is None
+    assert n == first and abs(_z_n(psi, z, n)) <= MAX_SPEED_M_S * _left_s(psi, n)
+
+
 def test_stop_turn_at_its_own_speed_against_the_drift() -> None:
     """V_s moving Z away: the earliest turn Step C's largest speed reaches (a few turns
     after the first: Z_n shrinks by 2πκ a turn while the time grows), no move time."""
@@ -126,11 +139,14 @@ def test_first_round_takes_the_move_time_it_is_given() -> None:
     assert step_c.phase is Phase.GO and step_c.b.target_m_s == pytest.approx(target)
 
 
-def test_no_round_without_turns_left() -> None:
-    """Inside the reserve before the stop Step C leaves Z as it is and says so."""
+@pytest.mark.parametrize("coast_fraction", [-0.5, 0.5])
+def test_no_round_without_time_for_it(coast_fraction: float) -> None:
+    """Less than a settle's time left before the reserve (inside it, or a half settle
+    before it): Step C leaves Z as it is, says so, and starts no Step B sequence."""
     step_c, psi = _step_c(), 0.0
-    step_c.start(psi - 0.5 * TWO_PI)
+    coast_rad = coast_fraction * step_c.p.settle_s * abs(SPIN_CHOICE_RAD_S)
+    step_c.start(psi - step_c.p.reserve_turns * TWO_PI - coast_rad)
     w = np.array([0.0, 0.0, SPIN_CHOICE_RAD_S])
-    torque = step_c.torque_B_Nm(0.0, ref.q_BR_of(ref.spin_dcm(psi)), w, psi, 1.0, 0.0)
+    step_c.torque_B_Nm(0.0, ref.q_BR_of(ref.spin_dcm(psi)), w, psi, 1.0, 0.0)
     assert step_c.phase is Phase.DONE and step_c.out_of_turns
-    assert np.all(np.isfinite(torque))
+    assert step_c.b.phase is PhaseB.DONE and step_c.b.kicks == 0

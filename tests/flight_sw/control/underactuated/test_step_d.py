@@ -118,11 +118,10 @@ def test_a_final_turn_passed_unseen_moves_the_stop_a_turn_later() -> None:
     step_d = StepD(ref.vehicle(), StepDParams(), ref.PERIOD_S)
     psi_f = 0.0
     step_d.start(psi_f)
-    psi = psi_f + 0.4 * TWO_PI  # 0.6 turn past the final turn's start
+    psi = psi_f - 0.6 * TWO_PI  # 1.6 turns past the final turn's start
     step_d.torque_III_Nm(psi, -0.1, step_d.aim_m(), np.zeros(2))
     assert step_d.phase is not Phase.FINAL
-    moved = step_d.postponed_turns
-    assert moved >= 1 and step_d.psi_f_rad == psi_f - TWO_PI * moved
+    assert step_d.postponed_turns == 2 and step_d.psi_f_rad == psi_f - 2 * TWO_PI
     assert step_d.psi_f_rad + TWO_PI < psi
 
 

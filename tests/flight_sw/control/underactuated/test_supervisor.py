@@ -52,8 +52,10 @@ def test_reaches_the_target_at_rest(case: str) -> None:
 
 def test_params_refuse_bad_values() -> None:
     """Margins and tolerances are checked by name."""
-    with pytest.raises(ConfigError, match="stop_margin_turns"):
-        SupervisorParams(stop_margin_turns=1)
+    with pytest.raises(ConfigError, match="stop_reserve_turns"):
+        SupervisorParams(stop_reserve_turns=1.0)
+    with pytest.raises(ConfigError, match="final_reserve_turns"):
+        SupervisorParams(final_reserve_turns=30.0)
     with pytest.raises(ConfigError, match="coarse_z_tol_m"):
         SupervisorParams(coarse_z_tol_m=0.0)
     with pytest.raises(ConfigError, match="z_tol_m"):
