@@ -209,8 +209,7 @@ class Supervisor:
                     and self.step_d.phase is not PhaseD.VELOCITY):
                 torque = self.step_c.torque_B_Nm(t_s, q_BR, omega_BN_B, psi, float(r_R_m[2]),
                                                  float(v_R_m_s[2]))
-                if (self.step_c.phase in (PhaseC.GO, PhaseC.STOP)
-                        and self.step_b.phase is not PhaseB.SETTLE):
+                if self.step_b.phase is PhaseB.KICK:  # (Step C going or stopping)
                     return torque  # a kick: Step D waits
             seq = self.step_d.sequence
             if (self.step_d.phase is PhaseD.COAST and seq is not None
