@@ -102,6 +102,7 @@ COMPILED = [
     "flight_sw/allocation/dense.py",
     "flight_sw/allocation/dense_active_set.py",
     "flight_sw/estimation/rls_kernel.py",
+    "flight_sw/estimation/mekf_kernel.py",
     "flight_sw/fdir/thrust_model.py",
 ]
 PURE_ENV = "THRUSTER_HIL_PURE"

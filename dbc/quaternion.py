@@ -36,7 +36,10 @@ def unpack_quaternion(signals: dict[str, float]) -> tuple[float, float, float, f
     """The unit quaternion carried by ``signals`` (scalar first, largest component >= 0)."""
     rest = [float(signals[n]) for n in SIGNALS]
     big = int(signals["Largest"])
-    largest = math.sqrt(max(0.0, 1.0 - sum(c * c for c in rest)))
+    # explicit left-to-right sums: sum() of floats is compensated from Python 3.12, and a
+    # trace must not depend on the Python version
+    largest = math.sqrt(max(0.0, 1.0 - (rest[0] * rest[0] + rest[1] * rest[1]
+                                          + rest[2] * rest[2])))
     q = rest[:big] + [largest] + rest[big:]
-    n = math.sqrt(sum(x * x for x in q))
+    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)

@@ -96,7 +96,10 @@ def _quat(t: Table, key: str) -> Quat:
 def _turned(q_BN: Quat, rotation_deg: tuple[float, ...]) -> Quat:
     """``q_BN`` followed by a body-axis rotation given as a rotation vector [deg]
     (``[initial] attitude_offset_deg``: a dispersed initial attitude)."""
-    angle = math.radians(math.sqrt(sum(x * x for x in rotation_deg)))
+    sq = 0.0  # left to right (sum() of floats is compensated from Python 3.12)
+    for x in rotation_deg:
+        sq += x * x
+    angle = math.radians(math.sqrt(sq))
     if angle == 0.0:
         return q_BN
     axis = tuple(math.radians(x) / angle for x in rotation_deg)

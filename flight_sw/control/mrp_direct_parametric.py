@@ -198,5 +198,8 @@ def _times6(m: tuple[float, ...], x: tuple[float, ...]) -> Vec3:
     out = [0.0, 0.0, 0.0]
     for i in range(N_AXES):
         row = m[N_STATES * i:N_STATES * (i + 1)]
-        out[i] = sum(r * v for r, v in zip(row, x, strict=True))
+        acc = 0.0  # left to right (sum() of floats is compensated from Python 3.12)
+        for r, v in zip(row, x, strict=True):
+            acc += r * v
+        out[i] = acc
     return (out[0], out[1], out[2])

@@ -30,6 +30,10 @@ Models and equations (Hamilton, scalar-first; see :mod:`flight_sw.quaternion`):
   ``K = P Hᵀ (H P Hᵀ + R)⁻¹``, ``x̂ = K y``; reset ``q̂ ← q̂ ⊗ exp(â)`` (renormalised),
   ``b̂ ← b̂ + Δb̂``; Joseph-form covariance ``P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ``.
 
+The covariance arithmetic (``Φ P Φᵀ + Q_k``, the gain and the Joseph form) is
+:mod:`flight_sw.estimation.mekf_kernel`'s, on floats in one fixed summation order: numpy's
+6×6 products went through the CPU's BLAS kernel and gave different traces on two machines.
+
 Timing rules (all times are arguments; no clock is read):
 - The first gyro sample only sets the held rate and the filter time.
 - The first star-tracker sample initialises the attitude (``initialised`` becomes True) and
@@ -64,6 +68,7 @@ import numpy as np
 
 from dbc import validation as check
 from flight_sw.estimation.base import AttitudeEstimate
+from flight_sw.estimation.mekf_kernel import propagate_covariance, star_tracker_update
 from flight_sw.quaternion import (
     error_quaternion,
     from_rotation_vector,
@@ -117,6 +122,12 @@ class MekfParams:
         object.__setattr__(self, "initial_bias_B_rad_s", bias)
 
 
+def _norm4(q: np.ndarray) -> float:
+    """|q| in one fixed order (``q @ q`` is BLAS's, whose order depends on the CPU)."""
+    q0, q1, q2, q3 = q.tolist()
+    return math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+
+
 def _frozen(a: np.ndarray) -> np.ndarray:
     a.setflags(write=False)
     return a
@@ -127,21 +138,20 @@ class Mekf:
 
     def __init__(self, params: MekfParams) -> None:
         self._params = params
-        self._r_st = np.eye(N_AXES) * params.star_tracker_sigma_rad**2
-        self._p0 = np.diag(
-            [params.initial_attitude_sigma_rad**2] * N_AXES
-            + [params.initial_bias_sigma_rad_s**2] * N_AXES
-        )
+        self._r_st = params.star_tracker_sigma_rad**2
+        p0_diag = ([params.initial_attitude_sigma_rad**2] * N_AXES
+                   + [params.initial_bias_sigma_rad_s**2] * N_AXES)
+        self._p0 = [p0_diag[i] if i == j else 0.0
+                    for i in range(N_STATES) for j in range(N_STATES)]
         self._q_BN = identity()
         self._bias_B = np.array(params.initial_bias_B_rad_s, dtype=float)
-        self._cov = self._p0.copy()
+        self._cov = list(self._p0)  # 6×6, flat row-major (see mekf_kernel)
         self._t_ns: int | None = None  # time the attitude estimate refers to
         self._t_gyro_ns: int | None = None  # time of the newest gyro sample
         self._omega_meas_B: np.ndarray | None = None  # newest raw gyro sample
         self._initialised = False
         self._qd_dt_ns = -1  # one-entry cache of the discrete process noise
-        self._qd = np.zeros((N_STATES, N_STATES))
-        self._phi = np.eye(N_STATES)  # rows 0–2 rewritten per step; rows 3–5 stay [0 I]
+        self._qd = (0.0, 0.0, 0.0)  # Q_k's q11 [rad²], q12 [rad²/s], q22 [(rad/s)²]
         self.rejected_samples = 0
 
     @property
@@ -152,7 +162,7 @@ class Mekf:
     @property
     def covariance(self) -> np.ndarray:
         """A copy of the 6×6 error covariance (a [rad], Δb [rad/s])."""
-        return self._cov.copy()
+        return np.array(self._cov).reshape(N_STATES, N_STATES)
 
     # --- propagation -------------------------------------------------------------------
 
@@ -221,29 +231,22 @@ class Mekf:
         e12, e13, e23 = d1 * d2, d1 * d3, d2 * d3
         # Φ12 = −(I Δt − c1 [ω̂×] + c2 [ω̂×]²), with [ω̂×]² = ω̂ ω̂ᵀ − |ω̂|² I
         diag = -dt_s + c2 * w_sq
-        phi = self._phi
-        phi[:3] = (
-            (e00 + e11 - e22 - e33, 2.0 * (e12 + e03), 2.0 * (e13 - e02),
-             diag - c2 * w1 * w1, -c1 * w3 - c2 * w1 * w2, c1 * w2 - c2 * w1 * w3),
-            (2.0 * (e12 - e03), e00 - e11 + e22 - e33, 2.0 * (e23 + e01),
-             c1 * w3 - c2 * w1 * w2, diag - c2 * w2 * w2, -c1 * w1 - c2 * w2 * w3),
-            (2.0 * (e13 + e02), 2.0 * (e23 - e01), e00 - e11 - e22 + e33,
-             -c1 * w2 - c2 * w1 * w3, c1 * w1 - c2 * w2 * w3, diag - c2 * w3 * w3),
-        )  # fmt: skip
-        self._cov = phi @ self._cov @ phi.T + self._process_noise(dt_ns)
+        phi11 = [e00 + e11 - e22 - e33, 2.0 * (e12 + e03), 2.0 * (e13 - e02),
+                 2.0 * (e12 - e03), e00 - e11 + e22 - e33, 2.0 * (e23 + e01),
+                 2.0 * (e13 + e02), 2.0 * (e23 - e01), e00 - e11 - e22 + e33]
+        phi12 = [diag - c2 * w1 * w1, -c1 * w3 - c2 * w1 * w2, c1 * w2 - c2 * w1 * w3,
+                 c1 * w3 - c2 * w1 * w2, diag - c2 * w2 * w2, -c1 * w1 - c2 * w2 * w3,
+                 -c1 * w2 - c2 * w1 * w3, c1 * w1 - c2 * w2 * w3, diag - c2 * w3 * w3]
+        q11, q12, q22 = self._process_noise(dt_ns)
+        self._cov = propagate_covariance(self._cov, phi11, phi12, q11, q12, q22)
 
-    def _process_noise(self, dt_ns: int) -> np.ndarray:
+    def _process_noise(self, dt_ns: int) -> tuple[float, float, float]:
+        """Q_k's blocks (q11 I, q12 I, q22 I) for a step of ``dt_ns``, cached per step."""
         if dt_ns != self._qd_dt_ns:
             dt_s = dt_ns / NS_PER_S
             sv2 = self._params.gyro_arw_rad_sqrt_s**2
             su2 = self._params.gyro_bias_rw_rad_s_sqrt_s**2
-            eye = np.eye(N_AXES)
-            qd = np.zeros((N_STATES, N_STATES))
-            qd[:3, :3] = (sv2 * dt_s + su2 * dt_s**3 / 3.0) * eye
-            qd[:3, 3:] = -(su2 * dt_s**2 / 2.0) * eye
-            qd[3:, :3] = qd[:3, 3:]
-            qd[3:, 3:] = su2 * dt_s * eye
-            self._qd = qd
+            self._qd = (sv2 * dt_s + su2 * dt_s**3 / 3.0, -(su2 * dt_s**2 / 2.0), su2 * dt_s)
             self._qd_dt_ns = dt_ns
         return self._qd
 
@@ -257,7 +260,7 @@ class Mekf:
     def update_star_tracker(self, t_ns: int, q_meas_BN: np.ndarray) -> None:
         """Take one star-tracker quaternion (maps N to B) measured at ``t_ns``."""
         qm = np.array(q_meas_BN, dtype=float)
-        norm = math.sqrt(float(qm @ qm)) if qm.shape == (4,) else 0.0
+        norm = _norm4(qm) if qm.shape == (4,) else 0.0
         if not (norm > 0.0 and math.isfinite(norm)):
             self.rejected_samples += 1
             return
@@ -274,21 +277,18 @@ class Mekf:
             qm = multiply(qm, from_rotation_vector(self._omega_hat_B() * age_s))
         if not self._initialised:
             self._q_BN = with_positive_scalar(qm)
-            self._cov = self._p0.copy()
+            self._cov = list(self._p0)
             self._initialised = True
             return
-        y = to_rotation_vector(error_quaternion(self._q_BN, qm))
-        cov = self._cov
-        s = cov[:3, :3] + self._r_st
-        gain = np.linalg.solve(s, cov[:3, :]).T  # K = P Hᵀ S⁻¹ (P, S symmetric)
-        dx = gain @ y
-        q = multiply(self._q_BN, from_rotation_vector(dx[:3]))
-        self._q_BN = with_positive_scalar(q / math.sqrt(float(q @ q)))
-        self._bias_B = self._bias_B + dx[3:]
-        ikh = np.eye(N_STATES)
-        ikh[:, :3] -= gain
-        cov = ikh @ cov @ ikh.T + gain @ self._r_st @ gain.T
-        self._cov = 0.5 * (cov + cov.T)
+        y1, y2, y3 = to_rotation_vector(error_quaternion(self._q_BN, qm)).tolist()
+        updated = star_tracker_update(self._cov, self._r_st, [y1, y2, y3])
+        if updated is None:  # a non-finite covariance: refuse the sample, keep the state
+            self.rejected_samples += 1
+            return
+        dx, self._cov = updated
+        q = multiply(self._q_BN, from_rotation_vector(np.array(dx[:3])))
+        self._q_BN = with_positive_scalar(q / _norm4(q))
+        self._bias_B = self._bias_B + np.array(dx[3:])
 
     # --- output ------------------------------------------------------------------------
 
@@ -299,6 +299,6 @@ class Mekf:
             q_BN=_frozen(self._q_BN.copy()),
             omega_BN_B=_frozen(self._omega_hat_B()),
             gyro_bias_B_rad_s=_frozen(self._bias_B.copy()),
-            covariance_diag=_frozen(np.diag(self._cov).copy()),
+            covariance_diag=_frozen(np.array(self._cov[::N_STATES + 1])),
             initialised=self._initialised,
         )

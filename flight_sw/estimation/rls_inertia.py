@@ -297,7 +297,11 @@ class RlsInertiaIdentifier:
         phi, y = kernel.window_equation(
             win.h_s, win.omega_B[0], win.omega_B[-1], win.gyro, win.torque_B_Nm
         )
-        if math.sqrt(sum(v * v for row in phi for v in row)) < self._params.min_regressor_norm:
+        sq = 0.0  # left to right (sum() of floats is compensated from Python 3.12)
+        for row in phi:
+            for v in row:
+                sq += v * v
+        if math.sqrt(sq) < self._params.min_regressor_norm:
             return self._output()
         self._step(phi, y)
         return self._output()

@@ -231,7 +231,7 @@ def test_covariance_transition_matches_matrix_exponential() -> None:
             )
         )
         mekf.update_star_tracker(0, Q0_BN)
-        mekf._cov = p0.copy()  # a full-rank, axis-distinct starting covariance
+        mekf._cov = p0.ravel().tolist()  # a full-rank, axis-distinct starting covariance
         dt_ns = 50_000_000
         mekf.propagate(0, rate)
         mekf.propagate(dt_ns, rate)

@@ -205,7 +205,8 @@ def make_state(
     vals = [float(x) for x in q_BN]
     if len(vals) != len(QUAT_IDENTITY):
         raise ValueError(f"q_BN must have 4 components, got {q_BN!r}")
-    norm = math.sqrt(sum(x * x for x in vals))
+    norm = math.sqrt(vals[0] * vals[0] + vals[1] * vals[1] + vals[2] * vals[2]
+                     + vals[3] * vals[3])
     if not abs(norm - 1.0) <= QUAT_NORM_TOL:
         raise ValueError(f"q_BN must be a unit quaternion, got norm {norm!r}")
     parts = (omega_BN_B, r_N, v_N)
