@@ -104,6 +104,7 @@ COMPILED = [
     "flight_sw/estimation/rls_kernel.py",
     "flight_sw/estimation/mekf_kernel.py",
     "flight_sw/fdir/thrust_model.py",
+    "flight_sw/fdir/residual_kernel.py",
 ]
 PURE_ENV = "THRUSTER_HIL_PURE"
 PACKAGES = ("bench", "dbc", "flight_sw")

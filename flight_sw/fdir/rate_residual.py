@@ -81,6 +81,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flight_sw.fdir import residual_kernel
 from flight_sw.fdir.base import (
     NOTHING,
     FailureKind,
@@ -143,7 +144,7 @@ class RateResidualFdir(ThrusterFdirStrategy):
     ) -> None:
         self._res = ResidualModel(effectiveness, inertia_B_kgm2, mass_kg, max_thrust_N, min_on_s,
                                   control_period_ns, imu_period_ns, params)
-        self._lin_sq = self._res.lin**2  # (3, n), a constant of the vehicle
+        self._lin_l: list[list[float]] = self._res.lin.tolist()  # (3, n), for the kernel
         self.params = params
         self.n = self._res.n
         self._period_ns = control_period_ns
@@ -200,53 +201,25 @@ class RateResidualFdir(ThrusterFdirStrategy):
 
     # --- decision -------------------------------------------------------------------
 
-    def _hypotheses(self, res: Residual) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per hypothesis (closed 0..n−1, open n..2n−1): likelihood gain, β, window signature.
+    def _hypotheses(self, res: Residual) -> tuple[list[float], list[float]]:
+        """Per hypothesis (closed 0..n−1, open n..2n−1): likelihood gain and β.
 
         The gain is ``2β·hz − β²·hh`` (the drop of the cost ``‖z − β g‖²`` summed over the
         angular window residual and the accelerometer samples) at the least-squares β
-        clipped to ``[0, β_max]``; the window signature (6×2n) is ``g`` summed per window,
-        for the "explains the residual" test.
+        clipped to ``[0, β_max]`` (:func:`flight_sw.fdir.residual_kernel.hypotheses`).
         """
         p = self.params
-        n = self.n
-        stuck = self._res.thrust.stuck_open
-        frac_cmd = res.frac
-        if stuck.any():
-            frac_cmd = res.frac.copy()
-            frac_cmd[:, stuck] = 0.0
-        lin = self._res.lin
-        wl = res.w_lin @ lin  # (samples, n): Σ_axis r/σ² · lin_i
-        ivl = res.inv_var @ self._lin_sq  # (samples, n): Σ_axis lin_i²/σ²
-        g_ang_c = -res.h_ang * res.tau_cmd_s  # (3, n)
-        g_ang_o = res.h_ang * np.maximum(res.span_s - res.tau_cmd_s, 0.0)
-        z_ang = res.z[0:3]
-        hz = np.concatenate(
-            (
-                z_ang @ g_ang_c - (wl * frac_cmd).sum(axis=0),
-                z_ang @ g_ang_o + (wl * (1.0 - frac_cmd)).sum(axis=0),
-            )
-        )
-        hh = np.concatenate(
-            (
-                (g_ang_c**2).sum(axis=0) + (ivl * frac_cmd**2).sum(axis=0),
-                (g_ang_o**2).sum(axis=0) + (ivl * (1.0 - frac_cmd) ** 2).sum(axis=0),
-            )
-        )
         beta_max = 1.0 + p.thrust_rel_error + p.model_rel_error
-        # hz/hh where hh > 0, else 0, clipped to [0, β_max] (np.clip's result, cheaper)
-        beta = np.minimum(np.maximum(np.divide(hz, hh, out=np.zeros_like(hz), where=hh > 0.0),
-                                     0.0), beta_max)
-        gain = 2.0 * beta * hz - beta**2 * hh
-        known = np.concatenate((self._known, self._known))
-        gain[known] = -np.inf
-        dt = self._res.imu_period_s
-        u_open = res.frac.shape[0] * dt - res.u_s
-        sig = np.zeros((6, 2 * n))
-        sig[0:3, :n], sig[0:3, n:] = g_ang_c, g_ang_o
-        sig[3:6, :n] = -res.h_lin * np.where(self._res.thrust.stuck_open, 0.0, res.u_s)
-        sig[3:6, n:] = res.h_lin * np.maximum(u_open, 0.0)
-        return gain, beta, sig
+        stuck: list[bool] = self._res.thrust.stuck_open.tolist()
+        return residual_kernel.hypotheses(
+            res.z, res.h_ang, res.tau_cmd_s, res.span_s, res.frac, stuck, res.w_lin,
+            res.ivl, self._lin_l, self._known.tolist(), beta_max)
+
+    def _signature(self, res: Residual, h: int) -> list[float]:
+        """Hypothesis ``h``'s window signature (6), for the "explains the residual" test."""
+        stuck: list[bool] = self._res.thrust.stuck_open.tolist()
+        return residual_kernel.signature(h, res.h_ang, res.h_lin, res.tau_cmd_s, res.span_s,
+                                         res.u_s, stuck, len(res.frac), self._res.imu_period_s)
 
     def evaluate(self, t_ns: int) -> Verdict:
         """Threshold and persistence test, then isolation (see the module docstring)."""
@@ -258,11 +231,13 @@ class RateResidualFdir(ThrusterFdirStrategy):
         if res is None:
             return NOTHING
         z = res.z
-        zz = float(z @ z)
+        zz = 0.0
+        for v in z:
+            zz += v * v
         norm = math.sqrt(zz)
         n = self.n
-        gain, beta, sig = self._hypotheses(res)
-        best = int(np.argmax(gain))
+        gain, beta = self._hypotheses(res)
+        best = max(range(len(gain)), key=gain.__getitem__)  # the first of equal maxima
         if norm > p.threshold or gain[best] > p.glr_threshold:
             self._above += 1
         else:
@@ -274,11 +249,13 @@ class RateResidualFdir(ThrusterFdirStrategy):
         failure = None
         thruster = best % n
         kind = FailureKind.STUCK_OPEN if best >= n else FailureKind.STUCK_CLOSED
-        others = gain.copy()
-        others[[thruster, thruster + n]] = -np.inf
-        margin = float(gain[best] - others.max())
-        window_fit = z - beta[best] * sig[:, best]
-        unexplained = float(window_fit @ window_fit)
+        others = max((g for h, g in enumerate(gain) if h % n != thruster), default=-math.inf)
+        margin = gain[best] - others
+        sig = self._signature(res, best)
+        unexplained = 0.0
+        for z_i, s_i in zip(z, sig, strict=True):
+            fit = z_i - beta[best] * s_i
+            unexplained += fit * fit
         if detected:
             if self._t_detect is None:
                 self._t_detect = t_ns
@@ -294,12 +271,12 @@ class RateResidualFdir(ThrusterFdirStrategy):
         self.last = ResidualSample(
             res.t_a_ns,
             res.t_b_ns,
-            z,
+            np.array(z),
             norm,
             thruster,
             kind,
-            float(beta[best]),
-            float(gain[best]),
+            beta[best],
+            gain[best],
             margin,
             unexplained / zz if zz > 0.0 else 0.0,
         )

@@ -19,6 +19,10 @@ window and the expected-thrust model of the commands sent
   (``thrust_rel_error``), the timing error of the modelled valve edges
   (``edge_uncertainty_s``) and the accelerometer-bias uncertainty.
 
+The arithmetic is :mod:`flight_sw.fdir.residual_kernel`'s (floats, every sum in one
+order, no BLAS); what an accelerometer sample contributes to every window holding it
+(predicted force, variance, thrust-rate term) is computed once, when it is first used.
+
 Each thruster enters with its own maximum thrust ``T_max,i`` (a vector, shape (n,)): a
 thruster of a non-uniform layout predicts the rate change of its own thrust.
 
@@ -41,9 +45,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
+from flight_sw.fdir import residual_kernel as kernel
 from flight_sw.fdir.rate_residual_params import RateResidualParams
 from flight_sw.fdir.thrust_model import ThrustModel
-from flight_sw.quaternion import cross as cross3
 
 NS_PER_S = 1_000_000_000
 S_PER_NS = 1e-9
@@ -61,9 +65,9 @@ class _GyroSample:
     """A gyro sample, the cumulative modelled thrust-time up to it and edges near it."""
 
     t_ns: int
-    omega: np.ndarray
-    cum_s: np.ndarray | None = None
-    edges: np.ndarray | None = None
+    omega: list[float]
+    cum_s: list[float] | None = None
+    edges: list[float] | None = None
 
 
 @dataclass
@@ -71,25 +75,28 @@ class _AccelSample:
     """An accelerometer sample and the modelled thrust fraction and its rate at it."""
 
     t_ns: int
-    f: np.ndarray
-    row: np.ndarray | None = None  # f, thrust fraction and its rate, one row (one stacking)
+    f: list[float]
+    frac: list[float] | None = None  # modelled thrust fraction per thruster at t_ns
+    terms: list[float] | None = None  # its residual_kernel.sample_terms: predicted f, ...
+    ivl: list[float] | None = None  # ... and Σ_axis lin²/σ² per thruster
 
 
 @dataclass(frozen=True)
 class Residual:
-    """The residual of one window and what the hypothesis test needs (internal)."""
+    """The residual of one window and what the hypothesis test needs (internal; lists,
+    matrices as lists of rows, for :mod:`flight_sw.fdir.residual_kernel`)."""
 
     t_a_ns: int
     t_b_ns: int
     span_s: float
-    z: np.ndarray  # (6,) normalised window residual
-    tau_cmd_s: np.ndarray  # (n,) commanded thrust-time in the window [s]
-    h_ang: np.ndarray  # (3, n) angular change per second of full thrust, over σ
-    h_lin: np.ndarray  # (3, n) window velocity change per second of full thrust, over σ
-    u_s: np.ndarray  # (n,) sampled thrust-time [s]
-    frac: np.ndarray  # (samples, n) expected thrust fraction at the accelerometer samples
-    w_lin: np.ndarray  # (samples, 3) sample residual over its variance
-    inv_var: np.ndarray  # (samples, 3) 1/variance of each sample residual
+    z: list[float]  # (6,) normalised window residual
+    tau_cmd_s: list[float]  # (n,) commanded thrust-time in the window [s]
+    h_ang: list[list[float]]  # (3, n) angular change per second of full thrust, over σ
+    h_lin: list[list[float]]  # (3, n) window velocity change per second of full thrust, over σ
+    u_s: list[float]  # (n,) sampled thrust-time [s]
+    frac: list[list[float]]  # (samples, n) expected thrust fraction at the accel samples
+    w_lin: list[list[float]]  # (samples, 3) sample residual over its variance
+    ivl: list[list[float]]  # (samples, n) Σ_axis lin_i²/variance of each sample residual
 
 
 class ResidualModel:
@@ -125,6 +132,13 @@ class ResidualModel:
         # Per thruster, at its own full thrust: angular acceleration [rad/s²] and linear [m/s²].
         self.ang = j_inv @ b[3:6] * t_max
         self.lin = b[0:3] * (t_max / mass_kg)
+        # the same as lists for the kernel, and the noise parameters in its order
+        self._ang_l: list[list[float]] = self.ang.tolist()
+        self._lin_l: list[list[float]] = self.lin.tolist()
+        self._j_l: list[list[float]] = j.tolist()
+        self._j_inv_l: list[list[float]] = j_inv.tolist()
+        self._noise = [params.gyro_noise_rad_s, params.model_rel_error, params.thrust_rel_error,
+                       params.edge_uncertainty_s, params.accel_noise_m_s2, params.accel_bias_m_s2]
         self.imu_period_s = imu_period_ns * S_PER_NS
         self.window_ns = round(params.window_s * NS_PER_S)
         self._n_imu = math.ceil(self.window_ns / imu_period_ns) + HISTORY_MARGIN
@@ -150,13 +164,15 @@ class ResidualModel:
         """Keep the gyro sample (time order is the caller's; older samples are dropped)."""
         if self._gyro and t_ns <= self._gyro[-1].t_ns:
             return
-        self._gyro.append(_GyroSample(t_ns, np.array(omega_meas_B, dtype=float)))
+        w = np.asarray(omega_meas_B, dtype=float)
+        self._gyro.append(_GyroSample(t_ns, [float(w[0]), float(w[1]), float(w[2])]))
 
     def add_accel(self, t_ns: int, f_meas_B: np.ndarray) -> None:
         """Keep the accelerometer sample."""
         if self._accel and t_ns <= self._accel[-1].t_ns:
             return
-        self._accel.append(_AccelSample(t_ns, np.array(f_meas_B, dtype=float)))
+        f = np.asarray(f_meas_B, dtype=float)
+        self._accel.append(_AccelSample(t_ns, [float(f[0]), float(f[1]), float(f[2])]))
 
     def track_bias(self, fraction: float) -> None:
         """Move the accelerometer-bias estimate by ``fraction`` of the way towards the last
@@ -176,20 +192,24 @@ class ResidualModel:
         for j in range(i, len(gyro)):
             g = gyro[j]
             if prev is None or prev.cum_s is None:
-                g.cum_s = np.zeros(self.n)
+                g.cum_s = [0.0] * self.n
             else:
-                g.cum_s = prev.cum_s + model.thrust_time_s(prev.t_ns, g.t_ns)
-            g.edges = model.boundary_segments(g.t_ns, guard)
+                step = model.thrust_time_s(prev.t_ns, g.t_ns).tolist()
+                g.cum_s = [c + d for c, d in zip(prev.cum_s, step, strict=True)]
+            g.edges = model.boundary_segments(g.t_ns, guard).tolist()
             prev = g
         accel = self._accel
         i = len(accel)
-        while i > 0 and accel[i - 1].row is None:
+        while i > 0 and accel[i - 1].frac is None:
             i -= 1
         new = [accel[j] for j in range(i, len(accel))]
         if new:
             frac, rate = model.fraction_at(np.array([a.t_ns for a in new], dtype=np.int64))
+            frac_l, rate_l = frac.tolist(), rate.tolist()
             for i, a in enumerate(new):
-                a.row = np.concatenate((a.f, frac[i], rate[i]))
+                a.frac = frac_l[i]
+                a.terms, a.ivl = kernel.sample_terms(a.f, frac_l[i], rate_l[i], self._lin_l,
+                                                     self._noise)
 
     def _window(self, t_ns: int) -> tuple[_GyroSample, _GyroSample] | None:
         """The gyro samples opening and closing the window (the newest one closes it)."""
@@ -211,71 +231,24 @@ class ResidualModel:
         if win is None:
             return None
         self._refresh()
-        p = self.params
-        n = self.n
         ga, gb = win
         assert ga.cum_s is not None and gb.cum_s is not None
         assert ga.edges is not None and gb.edges is not None
-        t_a, w_a, t_b, w_b = ga.t_ns, ga.omega, gb.t_ns, gb.omega
+        t_a, t_b = ga.t_ns, gb.t_ns
         span_s = (t_b - t_a) * S_PER_NS
-        model = self.thrust
-        tau_s = gb.cum_s - ga.cum_s  # (n,) thrust-time in the window [s]
-        tau_cmd_s = np.where(model.stuck_open, 0.0, tau_s)
-        edges = ga.edges + gb.edges
-        # angular channel
-        w_bar = 0.5 * (w_a + w_b)
-        gyroscopic = self._j_inv @ cross3(w_bar, self._j @ w_bar) * span_s
-        dw_pred = self.ang @ tau_s - gyroscopic
-        r_ang = (w_b - w_a) - dw_pred
-        contrib_ang = self.ang * tau_s  # (3, n)
-        var_ang = (
-            2.0 * p.gyro_noise_rad_s**2
-            + (p.model_rel_error * dw_pred) ** 2
-            + (p.thrust_rel_error**2) * (contrib_ang**2).sum(axis=1)
-            + (p.edge_uncertainty_s**2) * (self.ang**2 @ edges)
-        )
-        sig_ang = np.sqrt(var_ang)
-        z = np.zeros(6)
-        z[0:3] = r_ang / sig_ang
-        h_ang = self.ang / sig_ang[:, None]
-        # linear channel (sampled like the accelerometer)
-        acc = [a for a in self._accel if t_a < a.t_ns <= t_b] if p.use_accel else []
-        self.pending_bias = None
-        s_count = len(acc) if len(acc) >= 2 else 0
-        frac = np.zeros((s_count, n))
-        w_lin = np.zeros((s_count, 3))
-        inv_var = np.zeros((s_count, 3))
-        h_lin = np.zeros((3, n))
-        u_s = np.zeros(n)
-        if s_count:
-            rows = np.array([a.row for a in acc])  # (samples, 3 + 2n), then each part
-            fs = np.ascontiguousarray(rows[:, :3])  # contiguous: the products below as
-            frac = np.ascontiguousarray(rows[:, 3 : 3 + n])  # on separately stacked arrays
-            rate = np.ascontiguousarray(rows[:, 3 + n :])
-            dt = self.imu_period_s
-            f_pred = frac @ self.lin.T  # (samples, 3)
-            r_s = (fs - self.bias) - f_pred
-            var_s = (
-                p.accel_noise_m_s2**2
-                + p.accel_bias_m_s2**2
-                + (p.model_rel_error * f_pred) ** 2
-                + (p.thrust_rel_error**2) * ((frac**2) @ (self.lin.T**2))
-                + (p.edge_uncertainty_s**2) * ((rate**2) @ (self.lin.T**2))
-            )
-            inv_var = 1.0 / var_s
-            w_lin = r_s * inv_var
-            u_s = frac.sum(axis=0) * dt  # sampled thrust-time per thruster [s]
-            r_lin = r_s.sum(axis=0) * dt
-            sig_lin = np.sqrt(
-                s_count * (p.accel_noise_m_s2 * dt) ** 2
-                + (p.accel_bias_m_s2 * span_s) ** 2
-                + (p.model_rel_error * (self.lin @ u_s)) ** 2
-                + (p.thrust_rel_error**2) * ((self.lin * u_s) ** 2).sum(axis=1)
-                + (p.edge_uncertainty_s * dt) ** 2 * ((rate @ self.lin.T) ** 2).sum(axis=0)
-            )
-            z[3:6] = r_lin / sig_lin
-            h_lin = self.lin / sig_lin[:, None]
-            # the means as numpy's mean takes them (add.reduce, then / count), less its
-            # overhead
-            self.pending_bias = fs.sum(axis=0) / s_count - f_pred.sum(axis=0) / s_count
-        return Residual(t_a, t_b, span_s, z, tau_cmd_s, h_ang, h_lin, u_s, frac, w_lin, inv_var)
+        stuck: list[bool] = self.thrust.stuck_open.tolist()
+        tau_s = [b - a for a, b in zip(ga.cum_s, gb.cum_s, strict=True)]  # thrust-time [s]
+        tau_cmd_s = [0.0 if st else t for st, t in zip(stuck, tau_s, strict=True)]
+        edges = [a + b for a, b in zip(ga.edges, gb.edges, strict=True)]
+        acc = [a for a in self._accel if t_a < a.t_ns <= t_b] if self.params.use_accel else []
+        if len(acc) < 2:  # no linear channel
+            acc = []
+        f = [a.f for a in acc]
+        terms = [a.terms for a in acc if a.terms is not None]
+        frac = [a.frac for a in acc if a.frac is not None]
+        ivl = [a.ivl for a in acc if a.ivl is not None]
+        z, h_ang, h_lin, u_s, w_lin, mean = kernel.window_residual(
+            self._ang_l, self._lin_l, self._j_l, self._j_inv_l, tau_s, edges, ga.omega,
+            gb.omega, span_s, f, terms, frac, self.bias.tolist(), self.imu_period_s, self._noise)
+        self.pending_bias = None if mean is None else np.array(mean)
+        return Residual(t_a, t_b, span_s, z, tau_cmd_s, h_ang, h_lin, u_s, frac, w_lin, ivl)
