@@ -10,16 +10,13 @@ file).
 
 from __future__ import annotations
 
-import os
+# First, before anything imports numpy: OpenBLAS reads its settings when it loads.
+import flight_sw.blas_env  # noqa: F401
 
-# One thread, as on a flight computer: OpenBLAS's worker threads (numpy's products of 3×3
-# and 6×16 matrices in the cycle) only spin between the cycles, taking the core the bench
-# needs (6 % of a lockstep quickstart's CPU). Before numpy is first imported; a value the
-# user set is kept.
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-
+# isort: split
 import contextlib
 import gc
+import os
 import sys
 from pathlib import Path
 

@@ -45,6 +45,7 @@ import numpy as np
 
 from dbc import validation as check
 from flight_sw.allocation.base import Allocator
+from flight_sw.allocation.dense import mat_vec, norm
 from flight_sw.control.base import (
     AttitudeController,
     PoseController,
@@ -144,6 +145,9 @@ class FlightComputer:
         n = len(self.modulators)
         self.max_thrust_N = np.array(check.vector("FlightComputer", "max_thrust_N",
                                                   self.max_thrust_N, n, 0.0, lo_open=True))
+        # the torque rows as lists, for the per-cycle product (dense.mat_vec: no BLAS)
+        self._torque_rows: list[list[float]] = (
+            [] if self.effectiveness is None else self.effectiveness[-TORQUE_DIM:].tolist())
 
     # --- sensor input -------------------------------------------------------------------
 
@@ -373,16 +377,17 @@ class FlightComputer:
             fdir.on_command(t_ns, np.array(on_times))
         if self.effectiveness is not None:  # the torque the valves are told to give
             mean_thrust_N = np.array(on_times) / period_s * self.max_thrust_N
-            self._torque_applied_B_Nm = self.effectiveness[-TORQUE_DIM:] @ mean_thrust_N
-        r_demand = demand - alloc.achieved
+            self._torque_applied_B_Nm = np.array(
+                mat_vec(self._torque_rows, mean_thrust_N.tolist()))
+        r_demand = (demand - alloc.achieved).tolist()
         r_torque = r_demand[-TORQUE_DIM:]
-        r_force = float(np.linalg.norm(r_demand[:-TORQUE_DIM]))  # 0 with the torque rows alone
+        r_force = norm(r_demand[:-TORQUE_DIM])  # 0 with the torque rows alone
         return CycleResult(
             on_times,
             self.mode,
             flags,
             bool(alloc.saturated),
-            float(np.linalg.norm(r_torque)),
+            norm(r_torque),
             self.imu_counter,
             (float(torque[0]), float(torque[1]), float(torque[2])),
             (float(force[0]), float(force[1]), float(force[2])),

@@ -21,8 +21,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flight_sw import vec3
 from flight_sw.guidance.base import AttitudeGuidance
-from flight_sw.quaternion import to_dcm
+from flight_sw.quaternion import dcm
+
+
+def _dcm(q: np.ndarray) -> vec3.Mat3:
+    q0, q1, q2, q3 = np.asarray(q, dtype=float).tolist()
+    return dcm(q0, q1, q2, q3)
+
+
+def _to_body(c_BN: vec3.Mat3, c_RN: vec3.Mat3, x_R: np.ndarray) -> np.ndarray:
+    """``C_BN C_RNᵀ x_R``: a reference-frame vector in body axes."""
+    return np.array(vec3.mat_vec(c_BN, *vec3.mat_t_vec(c_RN, *vec3.vec3(x_R))))
 
 
 @dataclass
@@ -65,9 +76,11 @@ class References:
         if self.guidance is not None:
             ref = self.guidance.reference(t_ns - tl.time_base_ns)
             q_RN = np.asarray(ref.q_RN, dtype=float)
-            # body axes: C_BR = C_BN C_NR (feed-forward of the reference motion)
-            c_BR = to_dcm(q_BN) @ to_dcm(q_RN).T
-            return q_RN, c_BR @ ref.omega_RN_R, c_BR @ ref.domega_RN_R
+            # body axes: x_B = C_BN C_RNᵀ x_R (feed-forward of the reference motion), on
+            # floats (numpy's 3×3 products go through the CPU's BLAS kernel)
+            c_BN, c_RN = _dcm(q_BN), _dcm(q_RN)
+            return (q_RN, _to_body(c_BN, c_RN, ref.omega_RN_R),
+                    _to_body(c_BN, c_RN, ref.domega_RN_R))
         if t_ns - tl.time_base_ns >= tl.t_start_ns:
             return tl.q_target_BN, np.zeros(3), None
         if self._q_hold_BN is None:

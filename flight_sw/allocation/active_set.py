@@ -32,6 +32,7 @@ import numpy as np
 
 from flight_sw.allocation import dense_active_set as kernel
 from flight_sw.allocation.base import RANK_RTOL
+from flight_sw.allocation.dense import mat_vec, norm
 from flight_sw.allocation.dense_active_set import AT_LOWER, AT_UPPER, FREE  # active-set states
 
 # A thrust within ACTIVE_RTOL × (hi − lo) of a bound is taken as sitting on it.
@@ -72,8 +73,10 @@ def refine(b: np.ndarray, d: np.ndarray, t: np.ndarray, lo: np.ndarray, hi: np.n
     refined = refine_on_active_set(b, d, t, lo, hi)
     if refined is None:
         return t
-    r_ref, r_t = b @ refined - d, b @ t - d
-    if float(r_ref @ r_ref) <= float(r_t @ r_t) * (1.0 + REFINE_RTOL) + floor:
+    rows, d_l = b.tolist(), d.tolist()
+    r_ref = norm([a - x for a, x in zip(mat_vec(rows, refined.tolist()), d_l, strict=True)])
+    r_t = norm([a - x for a, x in zip(mat_vec(rows, t.tolist()), d_l, strict=True)])
+    if r_ref * r_ref <= r_t * r_t * (1.0 + REFINE_RTOL) + floor:
         return refined
     return t
 

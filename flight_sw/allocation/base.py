@@ -48,6 +48,7 @@ import numpy as np
 
 from dbc import validation as check
 from dbc.errors import ConfigError
+from flight_sw.allocation.dense import mat_vec, norm
 
 MAX_DEMAND_DIM = 6
 # Singular values below RANK_RTOL × the largest count as zero (rank, least-norm solutions).
@@ -175,7 +176,7 @@ def attained_tolerance(b_a: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float
 def trivial_result(d: np.ndarray, n: int) -> AllocationResult:
     """All-zero thrust for a non-finite demand (infinite residual) or no usable thruster."""
     finite = bool(np.all(np.isfinite(d)))
-    residual = float(np.linalg.norm(d)) if finite else math.inf
+    residual = norm(d.tolist()) if finite else math.inf
     m = d.shape[0]
     return AllocationResult(frozen(np.zeros(n)), frozen(np.zeros(m)), residual, residual > 0.0)
 
@@ -220,6 +221,9 @@ class ControlAllocation:
         self._lo_a, self._hi_a = lo[self._avail], hi[self._avail]
         self._b_a = b[:, self._avail]
         self._range_T = range_basis_T(self._b_a)
+        # as lists of rows for the per-cycle products (dense.mat_vec: no BLAS)
+        self._b_rows: list[list[float]] = b.tolist()
+        self._range_T_rows: list[list[float]] = self._range_T.tolist()
         self._attained_tol = attained_tolerance(self._b_a, self._lo_a, self._hi_a)
 
     # --- introspection -----------------------------------------------------------------
@@ -298,11 +302,8 @@ class ControlAllocation:
         else:
             thrust = np.zeros(n)
             thrust[self._avail] = t_a
-        achieved = self._b @ thrust
-        r = d - achieved
+        achieved = mat_vec(self._b_rows, thrust.tolist())
+        r = [d_i - a_i for d_i, a_i in zip(d.tolist(), achieved, strict=True)]
         if saturated is None:
-            in_range = self._range_T @ r
-            saturated = math.sqrt(float(in_range @ in_range)) > self._attained_tol
-        return AllocationResult(
-            frozen(thrust), frozen(achieved), math.sqrt(float(r @ r)), saturated
-        )
+            saturated = norm(mat_vec(self._range_T_rows, r)) > self._attained_tol
+        return AllocationResult(frozen(thrust), frozen(np.array(achieved)), norm(r), saturated)

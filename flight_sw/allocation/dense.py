@@ -27,6 +27,10 @@ thousand flops. Users: the allocators' exact active-set stages
   ``B_F`` itself (no squared condition number).
 - :func:`spd_solve`: ``A[idx, idx] x = b`` by Cholesky, or by :func:`least_norm_svd` with
   ``rcond`` when a pivot fails (a singular free set: the least-norm solution).
+- :func:`mat_vec` and :func:`norm`: ``A x`` and ``‖x‖`` with every sum in index order, for
+  the flight software's per-cycle products: numpy's ``@`` and ``np.linalg.norm`` go
+  through the BLAS kernel OpenBLAS picks for the CPU (their sums, and so the last bits,
+  differ between CPUs), and these make a run's arithmetic the same on every machine.
 
 In and out: plain lists (matrices as lists of rows), float64 arithmetic.
 
@@ -231,3 +235,24 @@ def least_norm(b: Matrix, free: list[int], r: list[float], rcond: float) -> list
     if x is not None:
         return x
     return least_norm_svd([[b[k][cf] for cf in free] for k in range(rows)], r, rcond)
+
+
+def mat_vec(a: Matrix, x: list[float]) -> list[float]:
+    """``A x`` for ``A`` as a list of rows, each sum in index order."""
+    out = [0.0] * len(a)
+    n = len(x)
+    for i in range(len(a)):
+        row = a[i]
+        acc = 0.0
+        for k in range(n):
+            acc += row[k] * x[k]
+        out[i] = acc
+    return out
+
+
+def norm(x: list[float]) -> float:
+    """The Euclidean norm of ``x``, its sum of squares in index order."""
+    acc = 0.0
+    for v in x:
+        acc += v * v
+    return math.sqrt(acc)

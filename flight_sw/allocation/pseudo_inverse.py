@@ -105,6 +105,7 @@ import numpy as np
 from dbc import validation as check
 from flight_sw.allocation.active_set import FREE, box_qp, refine, ridge
 from flight_sw.allocation.base import RANK_RTOL, BoundSpec, ControlAllocation
+from flight_sw.allocation.dense import mat_vec, norm
 from flight_sw.allocation.linear_program import solve_lp
 
 # The bounded least squares' ridge ε relative to the mean diagonal of BᵀB (step 3a, the
@@ -228,6 +229,9 @@ class PseudoInverseAllocator(ControlAllocation):
         b_a = self._b_a
         u_a = self._hi_a
         self._pinv = np.linalg.pinv(b_a, rcond=RANK_RTOL) if self._avail.size else np.zeros((0, m))
+        self._pinv_rows: list[list[float]] = self._pinv.tolist()  # per-cycle: dense.mat_vec
+        self._b_a_rows: list[list[float]] = b_a.tolist()
+        self._b_a_T_rows: list[list[float]] = b_a.T.tolist()
         rank = self._range_T.shape[0]
         self._null_v = _positive_null_vector(b_a, self._pinv) if rank else None
         self._rays = _min_fuel_null_rays(b_a) if self._null_v is not None else None
@@ -242,11 +246,12 @@ class PseudoInverseAllocator(ControlAllocation):
         self._definite = eps > 0.0
         self._m_list = self._m_mat.tolist()
         self._free = np.full(u_a.size, FREE, dtype=np.int8)
-        self._halfspaces: tuple[np.ndarray, np.ndarray] | None = None
+        self._halfspaces: tuple[list[list[float]], list[float]] | None = None
         if self._null_v is not None and params.exact_repair and rank:
             u_ref = float(np.max(u_a))
             normals, h = _attainable_halfspaces(self._range_T @ b_a, u_a / u_ref)
-            self._halfspaces = (normals @ self._range_T, u_ref * h + self._attained_tol)
+            self._halfspaces = ((normals @ self._range_T).tolist(),
+                                (u_ref * h + self._attained_tol).tolist())
 
     # --- introspection -----------------------------------------------------------------
 
@@ -270,19 +275,22 @@ class PseudoInverseAllocator(ControlAllocation):
         if self._halfspaces is None:
             return False
         normals_d, h_tol = self._halfspaces
-        return bool((normals_d @ d <= h_tol).all())
+        return all(x <= h for x, h in zip(mat_vec(normals_d, d.tolist()), h_tol, strict=True))
 
     def _bounded_lsq(self, d: np.ndarray) -> np.ndarray:
         """``argmin ‖B T − d‖²`` over ``0 ≤ T ≤ T_max`` (least-norm where not unique: the
         ridge of ``M``)."""
-        x, _ = box_qp(self._m_mat, self._b_a.T @ d, self._lo_a, self._hi_a, self._free,
-                      self._definite, self._m_list)
+        q = np.array(mat_vec(self._b_a_T_rows, d.tolist()))
+        x, _ = box_qp(self._m_mat, q, self._lo_a, self._hi_a, self._free, self._definite,
+                      self._m_list)
         # ε → 0 on the ridge's active set: the refinement makes the repair exact (the
         # ridge's answer alone misses an attainable demand by up to ~1e-7)
         return refine(self._b_a, d, x, self._lo_a, self._hi_a, self._attained_tol**2)
 
     def _in_range_residual(self, d: np.ndarray, t_a: np.ndarray) -> float:
-        return float(np.linalg.norm(self._range_T @ (d - self._b_a @ t_a)))
+        achieved = mat_vec(self._b_a_rows, t_a.tolist())
+        r = [d_i - a_i for d_i, a_i in zip(d.tolist(), achieved, strict=True)]
+        return norm(mat_vec(self._range_T_rows, r))
 
     def _solve(self, d: np.ndarray) -> tuple[np.ndarray, bool | None]:
         u_a = self._hi_a
@@ -292,7 +300,7 @@ class PseudoInverseAllocator(ControlAllocation):
             t_a = self._bounded_lsq(d)
             saturated = self._in_range_residual(d, t_a) > self._attained_tol
         else:
-            t_a = self._pinv @ d
+            t_a = np.array(mat_vec(self._pinv_rows, d.tolist()))
             if self._rays is not None:
                 rays = self._rays
                 for i in np.flatnonzero(t_a < 0.0).tolist():

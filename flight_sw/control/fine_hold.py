@@ -55,6 +55,7 @@ import numpy as np
 from dbc import validation as check
 from dbc.errors import ConfigError
 from flight_sw import quaternion as qt
+from flight_sw.allocation.dense import norm
 from flight_sw.control.base import AttitudeController, PoseController, TranslationController
 
 _SOURCE = "FineHoldParams"
@@ -113,12 +114,12 @@ class FineHold:
                   v_N_m_s: np.ndarray, q_RN: np.ndarray, omega_RN_B: np.ndarray,
                   r_ref_N_m: np.ndarray, v_ref_N_m_s: np.ndarray) -> bool:
         p = self.params
-        pos = float(np.linalg.norm(r_N_m - r_ref_N_m))
+        pos = norm((r_N_m - r_ref_N_m).tolist())
         att_deg = math.degrees(qt.rotation_angle_rad(qt.error_quaternion(q_RN, q_BN)))
         if self.in_fine_hold:
             return pos <= p.leave_position_m and att_deg <= p.leave_attitude_deg
-        speed = float(np.linalg.norm(v_N_m_s - v_ref_N_m_s))
-        rate_deg_s = math.degrees(float(np.linalg.norm(omega_BN_B - omega_RN_B)))
+        speed = norm((v_N_m_s - v_ref_N_m_s).tolist())
+        rate_deg_s = math.degrees(norm((omega_BN_B - omega_RN_B).tolist()))
         return (pos < p.enter_position_m and att_deg < p.enter_attitude_deg
                 and speed < p.enter_speed_m_s and rate_deg_s < p.enter_rate_deg_s)
 

@@ -39,8 +39,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc import validation as check
+from flight_sw import vec3
 from flight_sw.control.base import error_limit
-from flight_sw.quaternion import to_dcm
+from flight_sw.quaternion import dcm
 
 N_AXES = 3
 _SOURCE = "PositionPdParams"
@@ -119,7 +120,8 @@ class PositionPd:
         )
         v_err = np.asarray(v_N_m_s, dtype=float) - np.asarray(v_ref_N_m_s, dtype=float)
         f = -self._kp * r_err - self._kd * v_err
-        norm = math.sqrt(float(f @ f))
+        f0, f1, f2 = f.tolist()
+        norm = math.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
         if norm > self._f_max:
             f *= self._f_max / norm
         return f
@@ -134,4 +136,6 @@ class PositionPd:
         v_ref_N_m_s: np.ndarray,
     ) -> np.ndarray:
         """``F_B = C(q_BN) F_N`` [N] (see the module docstring)."""
-        return to_dcm(q_BN) @ self.force_N_N(r_N_m, v_N_m_s, r_ref_N_m, v_ref_N_m_s)
+        f0, f1, f2 = self.force_N_N(r_N_m, v_N_m_s, r_ref_N_m, v_ref_N_m_s).tolist()
+        q0, q1, q2, q3 = np.asarray(q_BN, dtype=float).tolist()
+        return np.array(vec3.mat_vec(dcm(q0, q1, q2, q3), f0, f1, f2))

@@ -52,10 +52,11 @@ def trace_lines(trace: Path) -> list[str]:
 
 
 def run_cli(args: list[str], out: Path, runtime_dir: Path, timeout_s: float = RUN_TIMEOUT_S,
-            extra_env: dict[str, str] | None = None) -> Run:
-    """Run ``thruster-hil ARGS --out OUT`` with a private hilbus runtime directory (and
-    ``extra_env`` added to the environment)."""
-    env = dict(os.environ, XDG_RUNTIME_DIR=str(runtime_dir), **(extra_env or {}))
+            extra_env: dict[str, str] | None = None, drop_env: tuple[str, ...] = ()) -> Run:
+    """Run ``thruster-hil ARGS --out OUT`` with a private hilbus runtime directory (with
+    ``extra_env`` added to the environment and the variables ``drop_env`` removed)."""
+    env = {k: v for k, v in os.environ.items() if k not in drop_env}
+    env.update(XDG_RUNTIME_DIR=str(runtime_dir), **(extra_env or {}))
     p = subprocess.run(
         [sys.executable, "-m", "bench.operator.entry", *args, "--out", str(out)],
         capture_output=True,

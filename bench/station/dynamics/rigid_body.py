@@ -116,7 +116,7 @@ class MassProperties:
         given = getattr(self, "inertia_B_kgm2")  # noqa: B009
         rows = check.matrix(src, "inertia_B_kgm2", given, MATRIX_DIM, MATRIX_DIM)
         j = check.inertia(src, "inertia_B_kgm2", given, physical=True)
-        j_inv = np.linalg.inv(j)
+        j_inv = np.array(inverse3(j.tolist()))
         j_inv = 0.5 * (j_inv + j_inv.T)
         object.__setattr__(self, "mass_kg", m)
         object.__setattr__(self, "inertia_B_kgm2", tuple(tuple(map(float, r)) for r in rows))
@@ -128,6 +128,24 @@ class MassProperties:
 
 
 # --- quaternion and frame helpers ---------------------------------------------------------
+def inverse3(a: list[list[float]]) -> list[list[float]]:
+    """``A⁻¹`` of a nonsingular 3×3 matrix by Gauss-Jordan elimination with partial pivoting
+    on floats: the same bits on every CPU (LAPACK's inverse runs on the BLAS kernel picked
+    for the CPU), and exactly ``1/A_ii`` on a diagonal (the usual principal-axis inertia)."""
+    n = MATRIX_DIM
+    m = [list(a[i]) + [1.0 if j == i else 0.0 for j in range(n)] for i in range(n)]
+    for col in range(n):
+        piv = max(range(col, n), key=lambda r: abs(m[r][col]))
+        m[col], m[piv] = m[piv], m[col]
+        p = m[col][col]
+        m[col] = [x / p for x in m[col]]
+        for r in range(n):
+            f = m[r][col]
+            if r != col and f != 0.0:
+                m[r] = [x - f * y for x, y in zip(m[r], m[col], strict=True)]
+    return [row[n:] for row in m]
+
+
 def quat_multiply(p: Quat, q: Quat) -> Quat:
     """Hamilton product p ⊗ q of scalar-first quaternions."""
     p0, p1, p2, p3 = p

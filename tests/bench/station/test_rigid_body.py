@@ -22,6 +22,7 @@ from bench.station.dynamics.rigid_body import (
     Wrench,
     angular_momentum_N,
     derivative,
+    inverse3,
     kinetic_energy,
     linear_momentum_N,
     make_state,
@@ -290,3 +291,17 @@ def test_rk4_step_is_pure() -> None:
     b = rk4_step(s, DT_S, w, w, w, mp)
     assert a == b
     assert s[IDX_Q0] == make_state(Q_TILTED, OMEGA_TUMBLE)[IDX_Q0]
+
+
+def test_inverse3_matches_numpy_and_is_exact_on_a_diagonal() -> None:
+    """The float Gauss-Jordan inverse equals numpy's to round-off on a full inertia and on
+    random pivoting cases, and is exactly 1/J_ii on a diagonal one."""
+    got = np.array(inverse3([list(r) for r in J_FULL]))
+    np.testing.assert_allclose(got @ np.array(J_FULL), np.eye(3), atol=ROUNDOFF_ABS_TOL)
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        a = rng.normal(size=(3, 3))
+        np.testing.assert_allclose(np.array(inverse3(a.tolist())), np.linalg.inv(a),
+                                   rtol=1e-9, atol=1e-9)
+    diag = [[17.0, 0.0, 0.0], [0.0, 19.0, 0.0], [0.0, 0.0, 22.0]]
+    assert inverse3(diag) == [[1 / 17.0, 0.0, 0.0], [0.0, 1 / 19.0, 0.0], [0.0, 0.0, 1 / 22.0]]

@@ -191,3 +191,17 @@ def test_cholesky_solve_known_answer(n: int) -> None:
     idx = list(range(0, n, 2)) or [0]
     x = dense.cholesky_solve(a, idx, [1.0] * len(idx), dense.PD_PIVOT_RTOL)
     assert x == pytest.approx([1.0 / (k + 1) for k in idx], rel=1e-15)
+
+
+def test_mat_vec_and_norm_match_numpy() -> None:
+    """``A x`` and ``‖x‖`` on floats equal numpy's to round-off on random 16×6 and 6×16
+    matrices; every sum runs in index order (a known answer with cancellation)."""
+    rng = np.random.default_rng(20261207)
+    for shape in ((16, 6), (6, 16), (3, 3)):
+        for _ in range(50):
+            a, x = rng.normal(size=shape), rng.normal(size=shape[1])
+            np.testing.assert_allclose(dense.mat_vec(a.tolist(), x.tolist()), a @ x,
+                                       rtol=1e-13, atol=1e-14)
+            assert dense.norm(x.tolist()) == pytest.approx(float(np.linalg.norm(x)), rel=1e-15)
+    # left to right: (1e16 + 1) − 1e16 = 0 in doubles; a compensated or reordered sum gives 1
+    assert dense.mat_vec([[1.0, 1.0, -1.0]], [1e16, 1.0, 1e16]) == [0.0]
