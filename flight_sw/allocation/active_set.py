@@ -32,7 +32,7 @@ import numpy as np
 
 from flight_sw.allocation import dense_active_set as kernel
 from flight_sw.allocation.base import RANK_RTOL
-from flight_sw.allocation.dense import mat_vec, norm
+from flight_sw.allocation.dense import mat_vec, sq_norm
 from flight_sw.allocation.dense_active_set import AT_LOWER, AT_UPPER, FREE  # active-set states
 
 # A thrust within ACTIVE_RTOL × (hi − lo) of a bound is taken as sitting on it.
@@ -74,9 +74,9 @@ def refine(b: np.ndarray, d: np.ndarray, t: np.ndarray, lo: np.ndarray, hi: np.n
     if refined is None:
         return t
     rows, d_l = b.tolist(), d.tolist()
-    r_ref = norm([a - x for a, x in zip(mat_vec(rows, refined.tolist()), d_l, strict=True)])
-    r_t = norm([a - x for a, x in zip(mat_vec(rows, t.tolist()), d_l, strict=True)])
-    if r_ref * r_ref <= r_t * r_t * (1.0 + REFINE_RTOL) + floor:
+    r_ref = sq_norm([a - x for a, x in zip(mat_vec(rows, refined.tolist()), d_l, strict=True)])
+    r_t = sq_norm([a - x for a, x in zip(mat_vec(rows, t.tolist()), d_l, strict=True)])
+    if r_ref <= r_t * (1.0 + REFINE_RTOL) + floor:
         return refined
     return t
 

@@ -27,7 +27,8 @@ thousand flops. Users: the allocators' exact active-set stages
   ``B_F`` itself (no squared condition number).
 - :func:`spd_solve`: ``A[idx, idx] x = b`` by Cholesky, or by :func:`least_norm_svd` with
   ``rcond`` when a pivot fails (a singular free set: the least-norm solution).
-- :func:`mat_vec` and :func:`norm`: ``A x`` and ``‖x‖`` with every sum in index order, for
+- :func:`mat_vec`, :func:`sq_norm` and :func:`norm`: ``A x``, ``‖x‖²`` and ``‖x‖`` with every sum
+  in index order, for
   the flight software's per-cycle products: numpy's ``@`` and ``np.linalg.norm`` go
   through the BLAS kernel OpenBLAS picks for the CPU (their sums, and so the last bits,
   differ between CPUs), and these make a run's arithmetic the same on every machine.
@@ -250,9 +251,14 @@ def mat_vec(a: Matrix, x: list[float]) -> list[float]:
     return out
 
 
-def norm(x: list[float]) -> float:
-    """The Euclidean norm of ``x``, its sum of squares in index order."""
+def sq_norm(x: list[float]) -> float:
+    """``‖x‖²``, the sum of squares in index order."""
     acc = 0.0
     for v in x:
         acc += v * v
-    return math.sqrt(acc)
+    return acc
+
+
+def norm(x: list[float]) -> float:
+    """The Euclidean norm of ``x`` (:func:`sq_norm`'s root)."""
+    return math.sqrt(sq_norm(x))

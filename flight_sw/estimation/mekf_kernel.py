@@ -23,14 +23,16 @@ In and out: ``P`` as a flat row-major list of 36 floats (attitude error ``a`` [r
 0-2, gyro bias error ``Δb`` [rad/s] rows 3-5); ``Φ11``, ``Φ12`` flat row-major 3×3 (Φ12
 [s]); ``q11`` [rad²], ``q12`` [rad²/s], ``q22`` [(rad/s)²]; ``r`` [rad²]; ``y`` [rad].
 
-Assumptions: ``P`` symmetric positive semi-definite, ``r > 0``, finite inputs (a non-finite
-``S`` is refused: :func:`star_tracker_update` returns None).
+Assumptions: ``P`` symmetric positive semi-definite, ``r > 0``; a non-finite ``P`` or ``y``
+is refused (:func:`star_tracker_update` returns None, the filter counts the sample).
 
 Sources: Markley & Crassidis 2014, "Fundamentals of Spacecraft Attitude Determination and
 Control", §6.2 (the MEKF's Φ, Q_k and update); Bucy & Joseph 1968 (the Joseph form).
 """
 
 from __future__ import annotations
+
+import math
 
 from flight_sw.allocation.dense import cholesky_solve
 
@@ -83,7 +85,8 @@ def propagate_covariance(p: list[float], phi11: list[float], phi12: list[float],
 def star_tracker_update(p: list[float], r: float, y: list[float]
                         ) -> tuple[list[float], list[float]] | None:
     """``(x̂, P⁺)`` of the update with ``H = [I 0]``, ``R = r I`` and residual ``y`` [rad];
-    None when ``S = A + r I`` is not numerically positive definite (non-finite input)."""
+    None when ``S = A + r I`` is not numerically positive definite or a result is not
+    finite (a non-finite input anywhere in ``P`` or ``y``)."""
     n = N_STATES
     s = [[p[i * n + j] + (r if i == j else 0.0) for j in range(N_AXES)] for i in range(N_AXES)]
     gain: list[list[float]] = []
@@ -114,7 +117,11 @@ def star_tracker_update(p: list[float], r: float, y: list[float]
                 acc += mp_i[k] * m_j[k]
             joseph[i][j] = acc + r * (k_i[0] * k_j[0] + k_i[1] * k_j[1] + k_i[2] * k_j[2])
     out = [0.0] * (n * n)
+    finite = True
     for i in range(n):
+        finite = finite and math.isfinite(dx[i])
         for j in range(n):
-            out[i * n + j] = 0.5 * (joseph[i][j] + joseph[j][i])
-    return dx, out
+            v = 0.5 * (joseph[i][j] + joseph[j][i])
+            finite = finite and math.isfinite(v)
+            out[i * n + j] = v
+    return (dx, out) if finite else None

@@ -126,6 +126,27 @@ class ResidualSample:
     unexplained: float
 
 
+def _argmax(x: list[float]) -> int:
+    """``np.argmax``: the first NaN if there is one, else the first of equal maxima."""
+    best = 0
+    for i, v in enumerate(x):
+        if v != v:
+            return i
+        if v > x[best]:
+            best = i
+    return best
+
+
+def _max_or_nan(x: list[float]) -> float:
+    """``np.max`` (NaN if any is NaN; −inf for none, as the hypotheses' masked gains)."""
+    out = -math.inf
+    for v in x:
+        if v != v:
+            return v
+        out = max(out, v)
+    return out
+
+
 class RateResidualFdir(ThrusterFdirStrategy):
     """Residual-based thruster FDIR (see the module docstring)."""
 
@@ -237,7 +258,7 @@ class RateResidualFdir(ThrusterFdirStrategy):
         norm = math.sqrt(zz)
         n = self.n
         gain, beta = self._hypotheses(res)
-        best = max(range(len(gain)), key=gain.__getitem__)  # the first of equal maxima
+        best = _argmax(gain)
         if norm > p.threshold or gain[best] > p.glr_threshold:
             self._above += 1
         else:
@@ -249,7 +270,7 @@ class RateResidualFdir(ThrusterFdirStrategy):
         failure = None
         thruster = best % n
         kind = FailureKind.STUCK_OPEN if best >= n else FailureKind.STUCK_CLOSED
-        others = max((g for h, g in enumerate(gain) if h % n != thruster), default=-math.inf)
+        others = _max_or_nan([g for h, g in enumerate(gain) if h % n != thruster])
         margin = gain[best] - others
         sig = self._signature(res, best)
         unexplained = 0.0

@@ -236,3 +236,25 @@ def test_maxima_of_the_wrong_shape_are_refused() -> None:
             RateResidualFdir(np.asarray(v["b"]), np.asarray(v["j_nom"]), SEED003_MASS_KG,
                              bad, MIN_ON_S, PERIOD_NS, IMU_NS, RateResidualParams())
         assert err.value.key == "max_thrust_N"
+
+
+def test_a_window_with_one_accelerometer_sample_has_no_linear_channel() -> None:
+    """Gyro samples throughout but one accelerometer sample in the window: evaluated on the
+    angular channel alone (linear z = 0), nothing raised."""
+    v = next(iter(VEHICLES.values()))
+    b = np.asarray(v["b"])
+    n = b.shape[1]
+    fdir = RateResidualFdir(b, np.asarray(v["j_nom"]), float(v["m_nom"]),  # type: ignore[arg-type]
+                            np.asarray(v["tmax"]), MIN_ON_S, PERIOD_NS, IMU_NS,
+                            RateResidualParams())
+    n_cycles = round(T_END_S * NS / PERIOD_NS)
+    for k in range(n_cycles):
+        t = k * PERIOD_NS
+        for s in range(PERIOD_NS // IMU_NS):
+            fdir.on_gyro(t + s * IMU_NS, np.zeros(3))
+        if k == n_cycles - 2:
+            fdir.on_accel(t, np.zeros(3))
+        fdir.evaluate(t)
+        fdir.on_command(t, np.zeros(n))
+    assert fdir.last is not None
+    assert np.array_equal(fdir.last.z[3:], np.zeros(3))

@@ -84,8 +84,12 @@ def test_update_equals_the_textbook_form(rng: np.random.Generator) -> None:
         assert all(got[i, i] < p[i, i] for i in range(3))
 
 
-def test_non_finite_covariance_is_refused() -> None:
-    """A NaN in the attitude block makes S non-finite: no update (None), nothing raised."""
+@pytest.mark.parametrize("index", [0, 4 * N + 4, 2 * N + 5])
+def test_non_finite_covariance_is_refused(index: int) -> None:
+    """A NaN anywhere in P (attitude block, bias block, cross terms): no update (None),
+    nothing raised; so is a NaN residual."""
     p = np.eye(N).ravel().tolist()
-    p[0] = math.nan
+    p[index] = math.nan
     assert star_tracker_update(p, SIGMA_ST_RAD**2, [0.0, 0.0, 0.0]) is None
+    assert star_tracker_update(np.eye(N).ravel().tolist(), SIGMA_ST_RAD**2,
+                               [math.nan, 0.0, 0.0]) is None
