@@ -38,6 +38,17 @@ def _dot3(m_row: Vector, v: Vector) -> float:
     return m_row[0] * v[0] + m_row[1] * v[1] + m_row[2] * v[2]
 
 
+def _net_and_squares(row: Vector, x: Vector) -> tuple[float, float]:
+    """``(Σ_k row_k x_k, Σ_k (row_k x_k)²)``: a net prediction and its per-thruster spread."""
+    net = 0.0
+    squares = 0.0
+    for k in range(len(x)):
+        t = row[k] * x[k]
+        net += t
+        squares += t * t
+    return net, squares
+
+
 def _angular(ang: Matrix, j: Matrix, j_inv: Matrix, tau_s: Vector, edges: Vector,
              w_a: Vector, w_b: Vector, span_s: float, noise: Vector
              ) -> tuple[Vector, Vector]:
@@ -52,13 +63,9 @@ def _angular(ang: Matrix, j: Matrix, j_inv: Matrix, tau_s: Vector, edges: Vector
     sig = [0.0, 0.0, 0.0]
     for i in range(N_AXES):
         a_i = ang[i]
-        pred = 0.0
-        contrib_sq = 0.0
+        pred, contrib_sq = _net_and_squares(a_i, tau_s)
         edge_sq = 0.0
         for k in range(n):
-            t = a_i[k] * tau_s[k]
-            pred += t
-            contrib_sq += t * t
             edge_sq += a_i[k] * a_i[k] * edges[k]
         pred -= _dot3(j_inv[i], c) * span_s
         var = (2.0 * gyro_noise * gyro_noise + (model_rel * pred) ** 2
@@ -151,12 +158,7 @@ def window_residual(ang: Matrix, lin: Matrix, j: Matrix, j_inv: Matrix, tau_s: V
     h_lin: Matrix = []
     for i in range(N_AXES):
         l_i = lin[i]
-        net = 0.0
-        each_sq = 0.0
-        for k in range(n):
-            t = l_i[k] * u_s[k]
-            net += t
-            each_sq += t * t
+        net, each_sq = _net_and_squares(l_i, u_s)
         sig = math.sqrt(s_count * (accel_noise * dt_s) ** 2 + (accel_bias * span_s) ** 2
                         + (model_rel * net) ** 2 + thrust_rel * thrust_rel * each_sq
                         + (edge_s * dt_s) ** 2 * rate_lin_sq[i])
