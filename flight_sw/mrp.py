@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from flight_sw.quaternion import skew
-from flight_sw.vec3 import Mat3, Vec3, vec3
+from flight_sw.vec3 import Mat3, Vec3, mat_t_vec, vec3
 
 # |σ| above which :func:`switched` maps to the shadow set (σ and σˢ coincide at |σ| = 1).
 SHADOW_SWITCH_NORM_SQ = 1.0
@@ -81,10 +81,11 @@ def inverse_factor(norm_sq: float) -> float:
 
 def to_quaternion(sigma: np.ndarray) -> np.ndarray:
     """The unit quaternion ``((1 − s)/(1 + s), 2σ/(1 + s))`` of σ; ``q0 ≥ 0`` iff ``|σ| ≤ 1``."""
-    s = np.asarray(sigma, dtype=float)
-    norm_sq = float(s @ s)
+    s0, s1, s2 = np.asarray(sigma, dtype=float).tolist()
+    norm_sq = s0 * s0 + s1 * s1 + s2 * s2  # one fixed order (``s @ s`` is the CPU's BLAS)
     denom = 1.0 + norm_sq
-    return np.concatenate(([(1.0 - norm_sq) / denom], 2.0 * s / denom))
+    return np.array([(1.0 - norm_sq) / denom, 2.0 * s0 / denom, 2.0 * s1 / denom,
+                     2.0 * s2 / denom])
 
 
 def to_dcm(sigma: np.ndarray) -> np.ndarray:
@@ -139,19 +140,30 @@ def kinematics_matrix_rate(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarr
 
 def rate_to_omega(sigma: np.ndarray, sigma_dot: np.ndarray) -> np.ndarray:
     """``ω = F⁻¹(σ) σ̇`` [rad/s]: the body rate of the MRP trajectory at ``σ`` with rate ``σ̇``."""
-    return kinematics_matrix_inverse(sigma) @ np.asarray(sigma_dot, dtype=float)
+    s = vec3(sigma)
+    f = inverse_factor(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
+    return np.array(_g_times(f, kinematics(s[0], s[1], s[2]), vec3(sigma_dot)))
+
+
+def _g_times(f: float, fk: Mat3, x: Vec3) -> Vec3:
+    """``G x = f Fᵀ x`` on floats, one fixed order (numpy's 3×3 products are the CPU's
+    BLAS): :func:`rate_to_omega` and :func:`omega_and_rate` share it."""
+    w = mat_t_vec(fk, *x)
+    return (f * w[0], f * w[1], f * w[2])
 
 
 def omega_and_rate(sigma: np.ndarray, sigma_dot: np.ndarray, sigma_ddot: np.ndarray
                    ) -> tuple[np.ndarray, np.ndarray]:
     """``(ω, ω̇)`` of an MRP trajectory: :func:`rate_to_omega` and its derivative
     ``ω̇ = Ġ σ̇ + G σ̈`` [rad/s²] (module docstring), sharing ``G = F⁻¹(σ)``."""
-    s = np.asarray(sigma, dtype=float)
-    sd = np.asarray(sigma_dot, dtype=float)
-    sdd = np.asarray(sigma_ddot, dtype=float)
-    norm_sq = float(s @ s)
-    s_dot = 2.0 * float(s @ sd)
-    g = kinematics_matrix_inverse(s)
-    g_dot = (inverse_factor(norm_sq) * kinematics_matrix_rate(s, sd).T
-             - 2.0 * s_dot / (1.0 + norm_sq) * g)
-    return g @ sd, g_dot @ sd + g @ sdd
+    s, sd, sdd = vec3(sigma), vec3(sigma_dot), vec3(sigma_ddot)
+    norm_sq = s[0] * s[0] + s[1] * s[1] + s[2] * s[2]
+    s_dot = 2.0 * (s[0] * sd[0] + s[1] * sd[1] + s[2] * sd[2])
+    f = inverse_factor(norm_sq)
+    fk = kinematics(s[0], s[1], s[2])
+    # ω = G σ̇ with G = f Fᵀ; ω̇ = Ġ σ̇ + G σ̈ with Ġ = f Ḟᵀ − (2ṡ/(1 + s)) G
+    omega = _g_times(f, fk, sd)
+    a = _g_times(f, kinematics_rate(s, sd), sd)
+    b = _g_times(f, fk, sdd)
+    c = 2.0 * s_dot / (1.0 + norm_sq)
+    return np.array(omega), np.array([a[i] - c * omega[i] + b[i] for i in range(3)])

@@ -73,13 +73,20 @@ def conjugate(q: np.ndarray) -> np.ndarray:
     return np.array([q0, -q1, -q2, -q3])
 
 
+def norm(q: np.ndarray) -> float:
+    """``|q|``, its sum of squares in one fixed order (``q @ q`` is BLAS's, whose order
+    depends on the CPU's kernel)."""
+    q0, q1, q2, q3 = np.asarray(q, dtype=float).tolist()
+    return math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+
+
 def normalise(q: np.ndarray) -> np.ndarray:
     """``q / |q|``; raises ``ValueError`` for a zero or non-finite quaternion."""
     qa = np.asarray(q, dtype=float)
-    norm = math.sqrt(float(qa @ qa))
-    if not (norm > 0.0 and math.isfinite(norm)):
+    length = norm(qa)
+    if not (length > 0.0 and math.isfinite(length)):
         raise ValueError(f"cannot normalise quaternion {qa!r}")
-    return qa / norm
+    return qa / length
 
 
 def with_positive_scalar(q: np.ndarray) -> np.ndarray:

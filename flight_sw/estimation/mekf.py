@@ -77,6 +77,9 @@ from flight_sw.quaternion import (
     to_rotation_vector,
     with_positive_scalar,
 )
+from flight_sw.quaternion import (
+    norm as qt_norm,
+)
 
 NS_PER_S = 1_000_000_000
 N_STATES = 6
@@ -120,12 +123,6 @@ class MekfParams:
                        unit="rad/s")
         bias = check.triple(s, "initial_bias_B_rad_s", self.initial_bias_B_rad_s, unit="rad/s")
         object.__setattr__(self, "initial_bias_B_rad_s", bias)
-
-
-def _norm4(q: np.ndarray) -> float:
-    """|q| in one fixed order (``q @ q`` is BLAS's, whose order depends on the CPU)."""
-    q0, q1, q2, q3 = q.tolist()
-    return math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -260,7 +257,7 @@ class Mekf:
     def update_star_tracker(self, t_ns: int, q_meas_BN: np.ndarray) -> None:
         """Take one star-tracker quaternion (maps N to B) measured at ``t_ns``."""
         qm = np.array(q_meas_BN, dtype=float)
-        norm = _norm4(qm) if qm.shape == (4,) else 0.0
+        norm = qt_norm(qm) if qm.shape == (4,) else 0.0
         if not (norm > 0.0 and math.isfinite(norm)):
             self.rejected_samples += 1
             return
@@ -287,7 +284,7 @@ class Mekf:
             return
         dx, self._cov = updated
         q = multiply(self._q_BN, from_rotation_vector(np.array(dx[:3])))
-        self._q_BN = with_positive_scalar(q / _norm4(q))
+        self._q_BN = with_positive_scalar(q / qt_norm(q))
         self._bias_B = self._bias_B + np.array(dx[3:])
 
     # --- output ------------------------------------------------------------------------
