@@ -2,7 +2,7 @@
 
     ThrusterHilError              base of every error this project raises on purpose
     ├── ConfigError (ValueError)  a scenario or configuration value is wrong (file, key, value)
-    │   └── RefusedConfigError    another process refused its configuration (its own message)
+    │   └── RefusedConfigError    another process refused its configuration or a command
     ├── IcdError                  the DBC is unusable or a frame cannot be encoded from it
     ├── BusError                  a bus spec is malformed; base of the bus errors below
     │   ├── BusInitError          a bus cannot be opened      (can.CanInitializationError)
@@ -99,14 +99,17 @@ class ConfigError(ThrusterHilError, ValueError):
 
 
 class RefusedConfigError(ConfigError):
-    """A child process (the flight software) refused its configuration and said why.
+    """A process refused its configuration (the flight software, saying why) or a command
+    (the bench, a live FAULT_CMD: the bus carries only the refusal).
 
     ``message`` is the process's own error line, which names the file, key and value.
     """
 
-    def __init__(self, who: str, message: str) -> None:
+    def __init__(self, who: str, message: str, what: str = "its configuration") -> None:
+        """``what`` was refused (default: its configuration; a live fault command's
+        refusal names the command)."""
         self.source, self.key, self.value, self.expected = who, "", None, message
-        ValueError.__init__(self, f"{who} refused its configuration: {message}")
+        ValueError.__init__(self, f"{who} refused {what}: {message}")
 
 
 class IcdError(ThrusterHilError):

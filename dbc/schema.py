@@ -36,7 +36,8 @@ class Table:
         self._data = data
         self._source = source
         self._path = path
-        self._used: set[str] = set()
+        self._used: set[str] = set()  # read: accepted by done()
+        self._known: set[str] = set()  # asked for, read or not: what done() lists
 
     def _key(self, key: str) -> str:
         return f"{self._path}.{key}" if self._path else key
@@ -50,12 +51,15 @@ class Table:
         return ConfigError(self._source, self._key(key), value, expected)
 
     def has(self, key: str) -> bool:
-        """True if ``key`` is present."""
+        """True if ``key`` is present (an optional key: :meth:`done` lists it as one this
+        table takes, and accepts it only if it is then read)."""
+        self._known.add(key)
         return key in self._data
 
     def raw(self, key: str, default: Any = _MISSING) -> Any:
         """The raw value of ``key`` (required unless ``default`` is given)."""
         self._used.add(key)
+        self._known.add(key)
         if key not in self._data:
             if default is _MISSING:
                 # a near miss among the keys nobody has read yet (a read one is not a typo)
@@ -158,10 +162,12 @@ class Table:
         extra = sorted(set(self._data) - self._used)
         if extra:
             key = extra[0]
-            near = difflib.get_close_matches(str(key), sorted(self._used), n=1,
-                                             cutoff=NEAR_MISS_CUTOFF)
+            # the keys read, and the optional ones asked for that are absent (a key present
+            # but left unread here is not one this table takes)
+            takes = sorted(self._used | {k for k in self._known if k not in self._data})
+            near = difflib.get_close_matches(str(key), takes, n=1, cutoff=NEAR_MISS_CUTOFF)
             hint = f"did you mean {near[0]!r}? " if near else ""
-            known = ", ".join(sorted(self._used)) or "no keys"
+            known = ", ".join(takes) or "no keys"
             raise self.error(key, self._data[key], f"no such key here ({hint}this table "
                              f"takes: {known})")
 

@@ -85,9 +85,11 @@ def inject(bus_spec: str, cmd: FaultCommand, timeout_s: float = DEFAULT_TIMEOUT_
             if acked == counter:
                 if rejected:
                     raise RefusedConfigError(
-                        "the bench", f"FAULT_CMD {cmd.kind} --target {cmd.target} --param "
-                        f"{cmd.param:g}: not applicable to this bench (its events.jsonl and "
-                        "summary.json say why)")
+                        "the bench", f"{cmd.kind} --target {cmd.target} --param "
+                        f"{cmd.param:g} is not applicable to this bench; the bus carries "
+                        "only the refusal (BENCH_STATUS.FaultCmdRejected): the bench's "
+                        "console, events.jsonl and summary.json say why",
+                        what="the fault command")
                 return counter
     raise RunError(f"no acknowledgement of FAULT_CMD (counter {counter}) on {bus_spec} "
                    f"within {timeout_s} s")

@@ -66,8 +66,10 @@ def _faults(s: dict[str, Any]) -> list[str]:
                    f"{applied}".replace("  ", " "))
     fdir = s.get("fdir") or {}
     if fdir.get("failed_thruster") is not None:
+        t_s = fdir.get("detection_time_s")
+        when = "?" if t_s is None else f"{t_s:.2f}"
         out.append(f"FDIR isolated thruster {fdir['failed_thruster']} "
-                   f"({fdir.get('failure_kind')}) detected at {fdir.get('detection_time_s')} s")
+                   f"({fdir.get('failure_kind')}) detected at {when} s")
     return out
 
 

@@ -29,31 +29,32 @@ def apply_overrides(data: dict[str, Any], overrides: list[str], source: str) -> 
     the override.
     """
     for item in overrides:
+        cli = f"command line (--set on {source})"  # the blame: not the file's
         key, sep, text = item.partition("=")
         if not sep or not key:
-            raise ConfigError(source, "--set", item, "KEY=VALUE with a dotted KEY")
+            raise ConfigError(cli, "--set", item, "KEY=VALUE with a dotted KEY")
         try:
             value = parse_toml(f"v = {text}", source)["v"]
         except ConfigError as exc:
             if exc.key != SYNTAX_KEY:  # too deep, too many digits: not a string either
-                raise ConfigError(source, "--set", item, exc.expected) from exc
+                raise ConfigError(cli, "--set", item, exc.expected) from exc
             value = text
         table = data
-        parts = [_override_part(source, key, p) for p in key.split(".")]
+        parts = [_override_part(cli, key, p) for p in key.split(".")]
         for name, index in parts[:-1]:
             nxt = table.setdefault(name, {} if index is None else [])
             if index is not None:
                 if not isinstance(nxt, list) or not 0 <= index < len(nxt):
                     size = len(nxt) if isinstance(nxt, list) else 0
-                    raise ConfigError(source, key, item, f"{name!r} to be an array of tables "
+                    raise ConfigError(cli, key, item, f"{name!r} to be an array of tables "
                                       f"with an element {index} (it has {size})")
                 nxt = nxt[index]
             if not isinstance(nxt, dict):
-                raise ConfigError(source, key, item, f"{name!r} to be a table")
+                raise ConfigError(cli, key, item, f"{name!r} to be a table")
             table = nxt
         name, index = parts[-1]
         if index is not None:
-            raise ConfigError(source, key, item, "a key inside the element (e.g. "
+            raise ConfigError(cli, key, item, "a key inside the element (e.g. "
                               f"{name}[{index}].t_s), or the whole array: {name}=[...]")
         table[name] = value
 

@@ -175,6 +175,9 @@ class FaultBook:
         """Record a FAULT_CMD that is not applied, and acknowledge it as rejected."""
         self.cmd_rejected = True
         fields = {k: float(v) for k, v in signals.items() if k not in ("CRC", "AliveCounter")}
-        self.log.append({**fields, "t_s": t_ns / NS_PER_S, "source": FAULT_CMD_SOURCE,
-                         "applied": False, "why": why})
+        code = int(signals.get("FaultType", 0))
+        # the kind by name (the summary's fault lines name it), or its unknown number
+        kind = self._icd.fault_kinds.get(code, f"FaultType {code}")
+        self.log.append({**fields, "kind": kind, "t_s": t_ns / NS_PER_S,
+                         "source": FAULT_CMD_SOURCE, "applied": False, "why": why})
         events.append((t_ns, "fault_cmd_rejected", {**fields, "why": why}))

@@ -32,13 +32,16 @@ def test_inject_reaches_running_bench(
     args = ["run", str(QUICKSTART), "--bus", bus, "--mode", "realtime", "--duration", RUN_S]
     with running(args, out, runtime_dir):
         counter = inject(bus, FaultCommand("stuck_open", STUCK))
-        with pytest.raises(RefusedConfigError, match="not applicable to this bench"):
+        with pytest.raises(RefusedConfigError,
+                           match=r"refused the fault command: stuck_open --target 12 .*"
+                                 r"not applicable to this bench"):
             inject(bus, FaultCommand("stuck_open", MISSING_THRUSTER))
     s = json.loads((out / "summary.json").read_text())
     live = [f for f in s["faults"] if f.get("source") == "FAULT_CMD"]
     assert live and live[0]["kind"] == "stuck_open" and live[0]["thruster"] == STUCK
     refused = [f for f in live if f.get("applied") is False]
     assert len(refused) == 1 and f"Target = {MISSING_THRUSTER}" in refused[0]["why"]
+    assert refused[0]["kind"] == "stuck_open"  # named in the summary's fault line
     assert 0 <= counter < 15
     assert "thruster-hil fault_injected" in run_text(out, "trace.asc")
 

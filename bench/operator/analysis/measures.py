@@ -81,16 +81,22 @@ def cycle_time_violations(
     cycle_s: float,
     abs_tolerance_s: float | None,
     rel_tolerance: float | None,
+    early_allowed: bool = False,
 ) -> tuple[int | None, int | None]:
     """Inter-arrival times outside the absolute and the relative window (None: not checked).
 
     Absolute window: [cycle - abs_tolerance, cycle + abs_tolerance]; relative window:
     [cycle (1 - rel_tolerance), cycle (1 + rel_tolerance)], ``rel_tolerance`` a fraction.
     Limits are inclusive, as in CANoe (a violation is strictly shorter or longer).
+    ``early_allowed``: a message sent cyclically and also on an event (the DBC's
+    ``GenMsgSendType`` "CyclicAndSpontanX"): a shorter interval is an event's frame, and
+    only a longer one is a violation.
     """
     d = np.asarray(intervals_s, dtype=float)
 
     def count(lo: float, hi: float) -> int:
+        if early_allowed:
+            return int(np.count_nonzero(d > hi))
         return int(np.count_nonzero((d < lo) | (d > hi)))
 
     n_abs = (

@@ -105,6 +105,9 @@ from dbc.errors import ConfigError, IcdError, RunError
 
 MODES = ("lockstep", "realtime", "live")
 UNKNOWN_NODE = "?"
+# GenMsgSendType of a message sent cyclically and also at once on an event (the flight
+# software's status frames on a mode or flag change): shorter intervals are no violation
+SEND_CYCLIC_AND_EVENT = "CyclicAndSpontanX"
 RUN_SOURCE = "RunTiming"
 
 
@@ -212,6 +215,13 @@ class RunTiming:
             out[can_id] = (m.name, m.senders[0] if m.senders else UNKNOWN_NODE, cycle)
         return out
 
+    def _send_type(self, can_id: int) -> str | None:
+        """The DBC's ``GenMsgSendType`` of ``can_id`` (None: not in the DBC, or none)."""
+        try:
+            return self.db.get_message_by_frame_id(can_id).send_type
+        except KeyError:
+            return None
+
     def _id_of(self, name: str) -> int:
         for can_id, (n, _, _) in self._names.items():
             if n == name:
@@ -293,6 +303,7 @@ class RunTiming:
                 cycle_s,
                 None if o.cycle_abs_tolerance_ms is None else o.cycle_abs_tolerance_ms / MS_PER_S,
                 None if o.cycle_rel_tolerance_pct is None else o.cycle_rel_tolerance_pct / PCT,
+                early_allowed=self._send_type(can_id) == SEND_CYCLIC_AND_EVENT,
             )
         finite = np.isfinite(rows.seen_s)
         missed, gaps = missed_cycles(t, rows.counter[finite], cycle_s, o.missed_gap_periods)

@@ -143,8 +143,11 @@ ROWS: list[Row] = [
          "a finite number > 0"),
     _run("--set nosuch=1", "thruster-hil: error: command line --set nosuch=1 (on "
          "scenarios/quickstart.toml): nosuch = 1: expected no such key here (this table "
-         "takes: bus, dynamics, environment, events, expectations, faults, "
+         "takes: bus, disturbance, dynamics, environment, events, expectations, faults, "
          "flight_sw, initial, manoeuvre, scenario, sensors, thrusters, vehicle)"),
+    _run("--set vehicle.mass_kg", "thruster-hil: error: command line (--set on "
+         "scenarios/quickstart.toml): --set = 'vehicle.mass_kg': expected KEY=VALUE with a "
+         "dotted KEY"),
     Row(HIL, ("run", QUICKSTART, "--set", LONG_SET_ARG),
         "thruster-hil: error: command line --set vehicle.mass_kg=[0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "
         "0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, ... (on "
@@ -152,7 +155,8 @@ ROWS: list[Row] = [
         "0, ...]: expected a finite number > 0",
         shown=f"run {QUICKSTART} --set 'vehicle.mass_kg=[0, 0, ...]'  # 20 000 zeros"),
     Row(HIL, ("run", QUICKSTART, "--set", DEEP_SET_ARG),
-        "thruster-hil: error: scenarios/quickstart.toml: --set = str of 82 chars: "
+        "thruster-hil: error: command line (--set on scenarios/quickstart.toml): --set = "
+        "str of 82 chars: "
         "'a=[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[...]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]': "
         "expected tables, arrays and dotted keys nested at most 32 deep",
         shown=f"run {QUICKSTART} --set 'a=[[[...]]]'  # 40 nested arrays"),

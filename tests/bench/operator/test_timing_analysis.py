@@ -397,3 +397,29 @@ def test_a_lean_run_is_refused_naming_what_it_lacks(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="lean") as err:
         RunTiming.load(tmp_path)
     assert "campaign rerun" in str(err.value)
+
+
+
+FSW_STATUS = 0x090  # DBC ID; GenMsgSendType "CyclicAndSpontanX", GenMsgCycleTime 100 ms
+STATUS_PERIOD_S = 100 * MS
+
+
+def _cyclic_with_extra_and_late(can_id: int, period_s: float) -> list[list[float]]:
+    """Frames at k·period for k = 0..10, one more at 4.3 periods, and the one at 9 periods
+    sent half a period late."""
+    times = [k * period_s for k in range(11) if k != 9] + [4.3 * period_s, 9.5 * period_s]
+    return [_frame(t, t + 100 * US, can_id, k % 15, tx=0) for k, t in enumerate(sorted(times))]
+
+
+def test_an_event_frame_of_a_cyclic_and_event_message_is_no_violation(tmp_path: Path) -> None:
+    """FSW_STATUS (sent every 100 ms and at once on a mode change, per the DBC's send type):
+    the extra frame between two cyclic ones is no violation, the late one still is; the same
+    pattern on IMU_RATE (plain cyclic) is a violation each way."""
+    rows = (_cyclic_with_extra_and_late(FSW_STATUS, STATUS_PERIOD_S)
+            + _cyclic_with_extra_and_late(IMU_RATE, IMU_PERIOD_S))
+    rt = RunTiming.load(_write_run(tmp_path, sorted(rows, key=lambda r: r[2])))
+    s = rt.message("FSW_STATUS")
+    assert s.count == 12
+    assert (s.cycle_violations_abs, s.cycle_violations_rel) == (1, 1)  # 8 -> 9.5 periods
+    i = rt.message("IMU_RATE")
+    assert (i.cycle_violations_abs, i.cycle_violations_rel) == (4, 4)  # 4.3 (2), 9.5 (2)

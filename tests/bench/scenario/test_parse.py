@@ -145,8 +145,9 @@ def test_overrides_set_nested_keys_and_are_validated() -> None:
     assert sc.bus.bitrate_bps == 125_000 and sc.flight_sw["modulator"]["km"] == 10.0
     with pytest.raises(ConfigError, match=r"bus\.bitrate_bps"):
         load_scenario(QUICKSTART, ["bus.bitrate_bps=fast"])
-    with pytest.raises(ConfigError, match="KEY=VALUE"):
+    with pytest.raises(ConfigError, match="KEY=VALUE") as err:
         load_scenario(QUICKSTART, ["bitrate"])
+    assert err.value.source == f"command line (--set on {QUICKSTART})"
 
 
 def test_a_bad_override_is_blamed_on_the_command_line() -> None:
