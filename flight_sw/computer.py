@@ -54,6 +54,8 @@ from flight_sw.control.base import (
 from flight_sw.estimation.base import AttitudeEstimator, InertiaIdentifier
 from flight_sw.fdir.base import ThrusterFailure
 from flight_sw.fdir.frozen_sensor import FrozenSensorMonitor
+from flight_sw.fdir.layout_check import LayoutCheck
+from flight_sw.fdir.layout_check import describe as describe_layout
 from flight_sw.fdir.sensor_watchdog import SensorWatchdog
 from flight_sw.fdir.thruster_fdir import FdirReport, ThrusterFdir
 from flight_sw.fdir.valve_status import status_flags
@@ -98,6 +100,20 @@ class CycleResult:
                    sensor_flags, fdir)
 
 
+def _sensor_flags(monitor: FrozenSensorMonitor, str_lost: bool, restarted: bool) -> int:
+    """FSW_FDIR.SensorFlags: frozen data, a degraded or lost star tracker, a bench restart."""
+    flags = 0
+    if monitor.frozen("IMU_RATE"):
+        flags |= SensorFlag.IMU_FROZEN
+    if monitor.frozen("STR_QUAT"):
+        flags |= SensorFlag.STR_FROZEN | SensorFlag.STR_DEGRADED
+    if str_lost:
+        flags |= SensorFlag.STR_DEGRADED
+    if restarted:
+        flags |= SensorFlag.BENCH_RESTART
+    return flags
+
+
 @dataclass
 class FlightComputer:
     """Estimator, controllers, allocator, modulators and FDIR wired into one cycle."""
@@ -126,6 +142,10 @@ class FlightComputer:
     # realtime: each cycle starts this long after one of the bench's control instants
     cycle_phase_ns: int = DEFAULT_CYCLE_PHASE_NS
     warnings: tuple[str, ...] = ()  # what this configuration cannot do (authority)
+    # what the thrusters an isolation leaves can do (flight_sw.fdir.layout_check)
+    layout_check: Callable[[np.ndarray], LayoutCheck] | None = None
+    #: one line per isolation that cost full control (the run's warnings)
+    layout_notes: list[str] = field(default_factory=list)
     mode: Mode = Mode.BOOT
     safe_latched: bool = False
     imu_counter: int = 0
@@ -244,10 +264,15 @@ class FlightComputer:
 
     # --- cycle --------------------------------------------------------------------------
 
-    def _reconfigure(self, failures: list[ThrusterFailure]) -> None:
-        """New allocator for the FDIR's mask; restart the failed thrusters' modulators."""
+    def _reconfigure(self, failures: list[ThrusterFailure], t_ns: int) -> None:
+        """New allocator for the FDIR's mask; restart the failed thrusters' modulators;
+        note what the thrusters left cannot do (:attr:`layout_notes`)."""
         assert self.thruster_fdir is not None
         mask = self.thruster_fdir.mask
+        if self.layout_check is not None:
+            note = describe_layout(self.layout_check(mask), t_ns / NS_PER_S)
+            if note is not None:
+                self.layout_notes.append(note)
         key = tuple(bool(x) for x in mask)
         alloc = self.allocators_by_mask.get(key)
         if alloc is None:
@@ -258,18 +283,6 @@ class FlightComputer:
         if self.make_modulator is not None:
             for f in failures:
                 self.modulators[f.thruster] = self.make_modulator()
-
-    def _sensor_flags(self, str_lost: bool) -> int:
-        flags = 0
-        if self.sensor_monitor.frozen("IMU_RATE"):
-            flags |= SensorFlag.IMU_FROZEN
-        if self.sensor_monitor.frozen("STR_QUAT"):
-            flags |= SensorFlag.STR_FROZEN | SensorFlag.STR_DEGRADED
-        if str_lost:
-            flags |= SensorFlag.STR_DEGRADED
-        if self.restarts:
-            flags |= SensorFlag.BENCH_RESTART
-        return flags
 
     def _nav(self, t_ns: int) -> tuple[np.ndarray, np.ndarray] | None:
         """The navigation position and velocity if both are fresh."""
@@ -303,7 +316,7 @@ class FlightComputer:
         str_lost = self.watchdog.lost("STR_QUAT", t_ns)
         if str_lost:
             flags |= FdirFlag.STR_LOST
-        sensor_flags = self._sensor_flags(str_lost)
+        sensor_flags = _sensor_flags(self.sensor_monitor, str_lost, self.restarts > 0)
         if sensor_flags & (SensorFlag.IMU_FROZEN | SensorFlag.STR_FROZEN):
             flags |= FdirFlag.SENSOR_FROZEN
         if self.restarts:
@@ -317,7 +330,7 @@ class FlightComputer:
         if fdir is not None:
             new = fdir.update(t_ns)
             if new:
-                self._reconfigure(new)
+                self._reconfigure(new, t_ns)
             report = fdir.report()
             if report.detected:
                 flags |= FdirFlag.THRUSTER_FAULT_DETECTED

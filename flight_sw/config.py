@@ -60,6 +60,7 @@ from flight_sw.computer import (
 from flight_sw.control.base import AttitudeController, PoseController
 from flight_sw.estimation.base import AttitudeEstimator
 from flight_sw.fdir.frozen_sensor import FrozenSensorMonitor, FrozenSensorParams
+from flight_sw.fdir.layout_check import LayoutCheck, check_layout
 from flight_sw.fdir.sensor_watchdog import LOST_AFTER_PERIODS, SensorWatchdog
 from flight_sw.fdir.thruster_fdir import ThrusterFdir
 
@@ -275,6 +276,12 @@ def build_computer(
         return built
 
     nav_period = watch_periods_ns.get("NAV_POS")
+    controls_force = vehicle.demand_rows == WRENCH_ROWS and not pure_torque
+    b_full, j_nominal = vehicle.effectiveness.copy(), vehicle.inertia_B_kgm2.copy()
+
+    def layout_check(mask: np.ndarray) -> LayoutCheck:
+        return check_layout(b_full, j_nominal, mask, controls_force)
+
     return FlightComputer(
         estimator=estimator,
         controller=controller,
@@ -300,11 +307,9 @@ def build_computer(
         pose=pose,
         cycle_phase_ns=round(phase_s * NS_PER_S),
         pure_torque=pure_torque,
+        layout_check=layout_check,
         warnings=(
-            *authority_warnings(
-                vehicle.effectiveness,
-                controls_force=vehicle.demand_rows == WRENCH_ROWS and not pure_torque,
-            ),
+            *authority_warnings(vehicle.effectiveness, controls_force=controls_force),
             *pure_torque_note,
         ),
     )

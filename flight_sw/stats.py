@@ -113,7 +113,7 @@ def stats_record(st: NodeStats, received: dict[str, dict[str, Any]], fc: FlightC
             "withheld_unphysical": fc.inertia_id.n_unphysical},
         "restarts": st.restarts,
         "restarts_refused": restarts_refused,
-        "warnings": list(fc.warnings),
+        "warnings": list(fc.warnings) + fc.layout_notes,
         "fdir": _fdir(fc, res),
         "bus_overrun_drops": getattr(bus, "overrun_drops", 0),
         "bus_overrun_drops_by_pid": {

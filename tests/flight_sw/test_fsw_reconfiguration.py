@@ -17,6 +17,7 @@ from flight_sw.fdir.base import (
     ThrusterFdirStrategy,
     Verdict,
 )
+from flight_sw.fdir.layout_check import LayoutCheck
 from flight_sw.fdir.sensor_watchdog import SensorWatchdog
 from flight_sw.fdir.thruster_fdir import ThrusterFdir
 from flight_sw.modes import FdirFlag, Mode
@@ -202,3 +203,32 @@ def test_flight_computer_wants_one_maximum_per_thruster() -> None:
             watchdog=SensorWatchdog({}),
         )
     assert info.value.key == "max_thrust_N"
+
+
+def test_each_isolation_checks_what_the_thrusters_left_can_do(
+    layout16: tuple[np.ndarray, np.ndarray]
+) -> None:
+    """The layout check runs on the mask of every reconfiguration, and an isolation that
+    costs full control leaves a note with its time (the run's warnings); one that keeps
+    it leaves none."""
+    b = effectiveness_matrix(*layout16)
+    t_iso = 4 * PERIOD_NS
+    fdir = ThrusterFdir(N, [Scripted(3, FailureKind.STUCK_CLOSED, t_iso)])
+    fc = computer(b, np.zeros(6), fdir)
+    masks: list[np.ndarray] = []
+
+    def lost(mask: np.ndarray) -> LayoutCheck:
+        masks.append(mask.copy())
+        return LayoutCheck(tuple(np.flatnonzero(mask).tolist()), ("torque +x",), ())
+
+    fc.layout_check = lost
+    for k in range(6):
+        fc.cycle(k * PERIOD_NS)
+    assert len(masks) == 1 and not masks[0][3] and masks[0].sum() == N - 1
+    assert len(fc.layout_notes) == 1 and "isolation at 0.08 s" in fc.layout_notes[0]
+    fc2 = computer(b, np.zeros(6), ThrusterFdir(N, [Scripted(3, FailureKind.STUCK_CLOSED,
+                                                             t_iso)]))
+    fc2.layout_check = lambda mask: LayoutCheck(tuple(np.flatnonzero(mask).tolist()), (), None)
+    for k in range(6):
+        fc2.cycle(k * PERIOD_NS)
+    assert fc2.layout_notes == []
