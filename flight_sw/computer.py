@@ -165,6 +165,7 @@ class FlightComputer:
         n = len(self.modulators)
         self.max_thrust_N = np.array(check.vector("FlightComputer", "max_thrust_N",
                                                   self.max_thrust_N, n, 0.0, lo_open=True))
+        self._max_thrust_list: list[float] = self.max_thrust_N.tolist()
         # the torque rows as lists, for the per-cycle product (dense.mat_vec: no BLAS)
         self._torque_rows: list[list[float]] = (
             [] if self.effectiveness is None else self.effectiveness[-TORQUE_DIM:].tolist())
@@ -379,19 +380,19 @@ class FlightComputer:
                 demand = demand - self.effectiveness[:, j] * self.max_thrust_N[j]
         alloc = self.allocator.allocate(demand)
         period_s = self.control_period_ns / NS_PER_S
-        mask = fdir.mask if fdir is not None else None
-        on_times = tuple(
-            0.0
-            if mask is not None and not mask[k]
-            else mod.on_time_s(t_ns, float(thrust) / self.max_thrust_N[k], period_s)
-            for k, (mod, thrust) in enumerate(zip(self.modulators, alloc.thrust_N, strict=True))
-        )
+        # on floats (one conversion each): the same divisions and products as numpy's
+        thrust_N, max_N = alloc.thrust_N.tolist(), self._max_thrust_list
+        usable = fdir.mask.tolist() if fdir is not None else None
+        on_list = [0.0] * len(thrust_N)
+        for k, (mod, t_N) in enumerate(zip(self.modulators, thrust_N, strict=True)):
+            if usable is None or usable[k]:
+                on_list[k] = mod.on_time_s(t_ns, t_N / max_N[k], period_s)
+        on_times = tuple(on_list)
         if fdir is not None:
             fdir.on_command(t_ns, np.array(on_times))
         if self.effectiveness is not None:  # the torque the valves are told to give
-            mean_thrust_N = np.array(on_times) / period_s * self.max_thrust_N
-            self._torque_applied_B_Nm = np.array(
-                mat_vec(self._torque_rows, mean_thrust_N.tolist()))
+            mean_thrust_N = [on / period_s * m for on, m in zip(on_list, max_N, strict=True)]
+            self._torque_applied_B_Nm = np.array(mat_vec(self._torque_rows, mean_thrust_N))
         r_demand = (demand - alloc.achieved).tolist()
         r_torque = r_demand[-TORQUE_DIM:]
         r_force = norm(r_demand[:-TORQUE_DIM])  # 0 with the torque rows alone
