@@ -239,6 +239,11 @@ class PseudoInverseAllocator(ControlAllocation):
         # inequalities mapped to demand space, ``normals·U_rᵀ d ≤ h + tol``.
         self._neg_inv_v = None if self._null_v is None else -1.0 / self._null_v
         self._overflow_N = u_a * (1.0 + THRUST_RTOL)
+        # the same as lists, for the per-cycle arithmetic on floats (_solve)
+        self._ray_rows = None if self._rays is None else self._rays.tolist()
+        self._neg_inv_v_list = [] if self._neg_inv_v is None else self._neg_inv_v.tolist()
+        self._null_v_list = [] if self._null_v is None else self._null_v.tolist()
+        self._overflow_list = self._overflow_N.tolist()
         # BᵀB + εI of the bounded least squares (array and lists, as the QP allocators keep
         # M): the ridge makes the answer the least-norm one and M definite (docstring, 3a)
         eps = ridge(b_a, LEAST_NORM_RIDGE_RTOL)
@@ -300,19 +305,20 @@ class PseudoInverseAllocator(ControlAllocation):
             t_a = self._bounded_lsq(d)
             saturated = self._in_range_residual(d, t_a) > self._attained_tol
         else:
-            t_a = np.array(mat_vec(self._pinv_rows, d.tolist()))
-            if self._rays is not None:
-                rays = self._rays
-                for i in np.flatnonzero(t_a < 0.0).tolist():
-                    ti = t_a[i]
+            # on floats: elementwise, the same operations in the same order as on arrays
+            t = mat_vec(self._pinv_rows, d.tolist())
+            if self._ray_rows is not None:
+                rays = self._ray_rows
+                for i in [k for k, x in enumerate(t) if x < 0.0]:
+                    ti = t[i]
                     if ti < 0.0:
-                        t_a -= ti * rays[i]
+                        t = [x - ti * r for x, r in zip(t, rays[i], strict=True)]
             else:
-                alpha = float((t_a * neg_inv_v).max())
+                alpha = max(x * w for x, w in zip(t, self._neg_inv_v_list, strict=True))
                 if alpha > 0.0:
-                    t_a += alpha * self._null_v
-            over = t_a > self._overflow_N
-            if over.any():
+                    t = [x + alpha * v for x, v in zip(t, self._null_v_list, strict=True)]
+            t_a = np.array(t)
+            if any(x > o for x, o in zip(t, self._overflow_list, strict=True)):
                 repaired = None
                 if self._attainable(d):
                     candidate = self._bounded_lsq(d)
