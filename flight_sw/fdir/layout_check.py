@@ -11,9 +11,11 @@ control (attitude and position with three thrusters) would still be possible.
 :func:`describe` makes that one line for the run's warnings (``summary.json`` and the
 console: nothing about a lost axis stays silent).
 
-The flight computer calls it on every reconfiguration (flight_sw.computer); the linear
-programmes cost ~1 ms each (12 at most), in the cycle of an isolation only, and the
-triple check runs only once full control is lost (few thrusters left, few triples).
+The flight computer calls it on every reconfiguration (flight_sw.computer), in the cycle
+of an isolation only: one linear programme when the survivors still positively span the
+controlled axes (:func:`positively_spans`: every axis reached, the usual single
+failure), else one per signed axis (12 at most) to name the lost ones and the triple
+check (few thrusters left, few triples).
 It reports; it does not switch controllers (seed 004 over the bus is not flown yet:
 docs/reproductions.md).
 
@@ -31,11 +33,15 @@ import numpy as np
 
 from dbc.errors import ConfigError
 from flight_sw.allocation.authority import unreached_axes
+from flight_sw.allocation.linear_program import solve_lp
 from flight_sw.control.underactuated.geometry import CONTROL_FRAMES, qualifying_triples
 
 FORCE_ROWS = slice(0, 3)
 TORQUE_ROWS = slice(3, 6)
 SHOWN_TRIPLES = 4  # triples named in the warning line (the count is always given)
+# the least weight of every thruster in a zero combination (weights ≤ 1) that counts as
+# strictly positive: far above the LP's tolerance (1e-7), far below any real layout's
+POSITIVE_WEIGHT_MIN = 1e-6
 
 
 @dataclass(frozen=True)
@@ -55,6 +61,21 @@ class LayoutCheck:
         return not self.unreached
 
 
+def positively_spans(rows: np.ndarray) -> bool:
+    """Whether the columns of ``rows`` (m × n) positively span R^m: they span it and some
+    strictly positive combination of them is 0 (Davis 1954). One linear programme,
+    ``max s`` over ``rows T = 0``, ``s ≤ T_i ≤ 1``, instead of one per signed axis."""
+    m, n = rows.shape
+    if n <= m or np.linalg.matrix_rank(rows) < m:
+        return False
+    # x = (T, s): minimise −s; T_i − s ≥ 0 as s − T_i ≤ 0
+    cost = np.r_[np.zeros(n), -1.0]
+    a_ub = np.hstack([-np.eye(n), np.ones((n, 1))])
+    x = solve_lp(cost, np.zeros(n + 1), np.ones(n + 1), np.hstack([rows, np.zeros((m, 1))]),
+                 np.zeros(m), a_ub, np.zeros(n))
+    return x is not None and float(x[n]) > POSITIVE_WEIGHT_MIN
+
+
 def check_layout(effectiveness: np.ndarray, inertia_B_kgm2: np.ndarray, mask: np.ndarray,
                  controls_force: bool) -> LayoutCheck:
     """The check of the module docstring for the thrusters ``mask`` leaves."""
@@ -62,6 +83,10 @@ def check_layout(effectiveness: np.ndarray, inertia_B_kgm2: np.ndarray, mask: np
     ok = np.asarray(mask, dtype=bool)
     available = tuple(int(k) for k in np.flatnonzero(ok))
     cols = b[:, ok]
+    # one LP when the survivors still positively span what is controlled (every axis
+    # reached: the usual single failure); the per-axis LPs only to name what is lost
+    if positively_spans(cols if controls_force else cols[TORQUE_ROWS]):
+        return LayoutCheck(available, (), None, "full control remains")
     unreached = [f"torque {a}" for a in unreached_axes(cols[TORQUE_ROWS])]
     if controls_force:
         unreached += [f"force {a}" for a in unreached_axes(cols[FORCE_ROWS])]

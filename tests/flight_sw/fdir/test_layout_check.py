@@ -5,9 +5,16 @@ from __future__ import annotations
 import numpy as np
 
 from bench.station.valves.layouts import LAYOUTS
+from flight_sw.allocation.authority import unreached_axes
 from flight_sw.allocation.effectiveness import effectiveness_matrix
 from flight_sw.control.underactuated.geometry import CONTROL_FRAMES, qualifying_triples
-from flight_sw.fdir.layout_check import SHOWN_TRIPLES, LayoutCheck, check_layout, describe
+from flight_sw.fdir.layout_check import (
+    SHOWN_TRIPLES,
+    LayoutCheck,
+    check_layout,
+    describe,
+    positively_spans,
+)
 
 SEED000_NOMINAL_INERTIA = np.diag([18.0, 18.0, 24.0])  # fdir_16thr's [vehicle.nominal]
 ARM_R_M, LENGTH_L_M = 0.5, 0.3
@@ -97,3 +104,20 @@ def test_a_non_diagonal_inertia_is_reported_unchecked() -> None:
     c = check_layout(_b("seed000_canted_16"), j, _mask((0, 5, 9)), controls_force=False)
     line = describe(c, T_S)
     assert c.triples is None and line is not None and "not checked" in line
+
+
+def test_positive_span_agrees_with_the_per_axis_check() -> None:
+    """The one-LP test says "spans" exactly when no signed torque axis is unreached (a cone
+    holding ±e_x, ±e_y, ±e_z is all of R³), on 60 random survivor sets of both layouts;
+    on the wrench rows "spans" implies every torque and force axis reached."""
+    rng = np.random.default_rng(20)
+    for layout in ("seed000_conventional_16", "seed000_canted_16"):
+        b = _b(layout)
+        for _ in range(30):
+            keep = rng.choice(N_THR, int(rng.integers(3, N_THR + 1)), replace=False)
+            cols = b[:, _mask(tuple(keep.tolist()))]
+            assert positively_spans(cols[3:]) == (unreached_axes(cols[3:]) == [])
+            if positively_spans(cols):
+                assert unreached_axes(cols[3:]) == [] and unreached_axes(cols[:3]) == []
+    assert positively_spans(_b("seed000_conventional_16"))  # docs: the 6×16 spans
+    assert not positively_spans(_b("seed000_conventional_16")[:, :6])  # n ≤ m never does
