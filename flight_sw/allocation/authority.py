@@ -27,6 +27,8 @@ from flight_sw.allocation.linear_program import solve_lp
 
 # An axis counts as reached when the residual ‖B T − e‖ is below this (unit target).
 REACH_TOL = 1e-9
+# Smallest component (of a unit-sum null vector) accepted as "strictly positive".
+NULL_VECTOR_MIN_COMPONENT = 1e-9
 AXES = ("x", "y", "z")
 def _cone_residual(rows: np.ndarray, target: np.ndarray) -> float:
     """``‖rows T − target‖`` at the ``T ≥ 0`` of least absolute residual (an LP)."""
@@ -72,3 +74,28 @@ def authority_warnings(b: np.ndarray, controls_force: bool) -> list[str]:
                 "there go unmet whatever the controller asks, and show only as an "
                 "allocation residual (fsw.allocation in summary.json)")
     return warnings
+
+
+def positive_null_vector(b: np.ndarray, pinv: np.ndarray) -> np.ndarray | None:
+    """A unit-sum v > 0 with B v = 0 maximising min v, or None if there is none: the
+    columns of B then positively span its range (``pinv``: B's pseudo-inverse, which
+    takes the LP's round-off back into the null space)."""
+    m, n = b.shape
+    cost = np.zeros(n + 1)
+    cost[-1] = -1.0  # maximise t
+    a_eq = np.zeros((m + 1, n + 1))
+    a_eq[:m, :n] = b
+    a_eq[m, :n] = 1.0
+    b_eq = np.zeros(m + 1)
+    b_eq[m] = 1.0
+    a_ub = np.hstack([-np.eye(n), np.ones((n, 1))])  # t − v_i ≤ 0
+    lo = np.r_[np.zeros(n), -np.inf]
+    x = solve_lp(cost, lo, np.full(n + 1, np.inf), a_eq, b_eq, a_ub, np.zeros(n))
+    if x is None:
+        return None
+    v = x[:n]
+    v = v - pinv @ (b @ v)  # remove the LP's round-off component outside the null space
+    v = v / v.sum()
+    if v.min() <= NULL_VECTOR_MIN_COMPONENT:
+        return None
+    return v

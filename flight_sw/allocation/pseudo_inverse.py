@@ -104,6 +104,7 @@ import numpy as np
 
 from dbc import validation as check
 from flight_sw.allocation.active_set import FREE, box_qp, refine, ridge
+from flight_sw.allocation.authority import positive_null_vector
 from flight_sw.allocation.base import RANK_RTOL, BoundSpec, ControlAllocation
 from flight_sw.allocation.dense import mat_vec, norm
 from flight_sw.allocation.linear_program import solve_lp
@@ -113,8 +114,6 @@ from flight_sw.allocation.linear_program import solve_lp
 # its active set is the least-norm answer's; its own residual (up to ~1e-7, several times
 # the attained tolerance) is removed by the refinement on that active set.
 LEAST_NORM_RIDGE_RTOL = 1e-9
-# Smallest component (of a unit-sum null vector) accepted as "strictly positive".
-NULL_VECTOR_MIN_COMPONENT = 1e-9
 # Per thruster number, the extra cost that breaks ties between null rays of equal fuel.
 RAY_ORDER_WEIGHT = 1e-9
 # Thrust above T_max,i × (1 + THRUST_RTOL) counts as an overflow (round-off slack).
@@ -145,29 +144,6 @@ class PseudoInverseParams:
         else:
             check.positive(_SOURCE, "max_thrust_N", t, unit="N")
         check.flag(_SOURCE, "exact_repair", self.exact_repair)
-
-
-def _positive_null_vector(b: np.ndarray, pinv: np.ndarray) -> np.ndarray | None:
-    """A unit-sum v > 0 with B v = 0 maximising min v, or None if there is none."""
-    m, n = b.shape
-    cost = np.zeros(n + 1)
-    cost[-1] = -1.0  # maximise t
-    a_eq = np.zeros((m + 1, n + 1))
-    a_eq[:m, :n] = b
-    a_eq[m, :n] = 1.0
-    b_eq = np.zeros(m + 1)
-    b_eq[m] = 1.0
-    a_ub = np.hstack([-np.eye(n), np.ones((n, 1))])  # t − v_i ≤ 0
-    lo = np.r_[np.zeros(n), -np.inf]
-    x = solve_lp(cost, lo, np.full(n + 1, np.inf), a_eq, b_eq, a_ub, np.zeros(n))
-    if x is None:
-        return None
-    v = x[:n]
-    v = v - pinv @ (b @ v)  # remove the LP's round-off component outside the null space
-    v = v / v.sum()
-    if v.min() <= NULL_VECTOR_MIN_COMPONENT:
-        return None
-    return v
 
 
 def _min_fuel_null_rays(b: np.ndarray) -> np.ndarray | None:
@@ -233,7 +209,7 @@ class PseudoInverseAllocator(ControlAllocation):
         self._b_a_rows: list[list[float]] = b_a.tolist()
         self._b_a_T_rows: list[list[float]] = b_a.T.tolist()
         rank = self._range_T.shape[0]
-        self._null_v = _positive_null_vector(b_a, self._pinv) if rank else None
+        self._null_v = positive_null_vector(b_a, self._pinv) if rank else None
         self._rays = _min_fuel_null_rays(b_a) if self._null_v is not None else None
         # Per-call helpers: −1/v for the shift, the overflow thresholds, and the attainable-set
         # inequalities mapped to demand space, ``normals·U_rᵀ d ≤ h + tol``.

@@ -32,16 +32,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from dbc.errors import ConfigError
-from flight_sw.allocation.authority import unreached_axes
-from flight_sw.allocation.linear_program import solve_lp
+from flight_sw.allocation.authority import positive_null_vector, unreached_axes
 from flight_sw.control.underactuated.geometry import CONTROL_FRAMES, qualifying_triples
 
 FORCE_ROWS = slice(0, 3)
 TORQUE_ROWS = slice(3, 6)
 SHOWN_TRIPLES = 4  # triples named in the warning line (the count is always given)
-# the least weight of every thruster in a zero combination (weights ≤ 1) that counts as
-# strictly positive: far above the LP's tolerance (1e-7), far below any real layout's
-POSITIVE_WEIGHT_MIN = 1e-6
 
 
 @dataclass(frozen=True)
@@ -63,17 +59,13 @@ class LayoutCheck:
 
 def positively_spans(rows: np.ndarray) -> bool:
     """Whether the columns of ``rows`` (m × n) positively span R^m: they span it and some
-    strictly positive combination of them is 0 (Davis 1954). One linear programme,
-    ``max s`` over ``rows T = 0``, ``s ≤ T_i ≤ 1``, instead of one per signed axis."""
+    strictly positive combination of them is 0 (Davis 1954): one linear programme
+    (:func:`~flight_sw.allocation.authority.positive_null_vector`, the pseudo-inverse
+    allocator's), instead of one per signed axis."""
     m, n = rows.shape
     if n <= m or np.linalg.matrix_rank(rows) < m:
         return False
-    # x = (T, s): minimise −s; T_i − s ≥ 0 as s − T_i ≤ 0
-    cost = np.r_[np.zeros(n), -1.0]
-    a_ub = np.hstack([-np.eye(n), np.ones((n, 1))])
-    x = solve_lp(cost, np.zeros(n + 1), np.ones(n + 1), np.hstack([rows, np.zeros((m, 1))]),
-                 np.zeros(m), a_ub, np.zeros(n))
-    return x is not None and float(x[n]) > POSITIVE_WEIGHT_MIN
+    return positive_null_vector(rows, np.linalg.pinv(rows)) is not None
 
 
 def check_layout(effectiveness: np.ndarray, inertia_B_kgm2: np.ndarray, mask: np.ndarray,
